@@ -1,0 +1,1 @@
+// Placeholder until platform code lands.

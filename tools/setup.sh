@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian packages mcslam needs (only those missing) and builds everything into build/.
+# Usage: tools/setup.sh            (Release build in ./build, executables in ./build/bin)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  build-essential cmake pkg-config git python3
+  libeigen3-dev libopencv-dev libopengv-dev libsuitesparse-dev libspdlog-dev libyaml-cpp-dev libcli11-dev
+  libaravis-dev aravis-tools libusb-1.0-0-dev libgpiod-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libceres-dev
+  systemd
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+jobs="$(nproc)"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j"$jobs"
+echo "setup: built; executables are in build/bin"
