@@ -1,1 +1,1 @@
-// Placeholder until the simulator lands.
+// Placeholder: keeps the library non-empty until its first source lands.
