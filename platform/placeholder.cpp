@@ -1,1 +1,0 @@
-// Placeholder until platform code lands.
