@@ -33,7 +33,7 @@ std::string format(const char* fmt, double v) {
 void printHeader(const EvalOptions& o, const Inputs& in, std::size_t pairs) {
   std::printf("  reference    %s (%zu poses)\n", in.reference_path.c_str(), in.reference_poses);
   std::printf("  estimate     %s (%zu poses)\n", in.estimate_path.c_str(), in.estimate_poses);
-  std::printf("  association  %zu pairs, max. time difference %g s", pairs, o.max_diff_s);
+  std::printf("  association  %zu poses matched, max. time difference %g s", pairs, o.max_diff_s);
   if (o.t_offset_s != 0) std::printf(", estimate time offset %g s", o.t_offset_s);
   std::printf("\n  alignment    %s\n", alignmentText(o.align));
 }
@@ -169,7 +169,7 @@ void printRpeJson(const RpeResult& r, const RpeOptions& o, const Inputs& in) {
 
 void plotRpe(const std::string& png, const RpeResult& r, const RpeOptions& o, const Inputs& in) {
   TrajectoryPlot p;
-  p.title = "RPE (translation, delta " + deltaText(o) + "): rmse " + format("%.4g m", r.translation.rmse) + ", rotation " +
+  p.title = "RPE (translation, delta " + deltaText(o) + "): rmse " + format("%.4g m", r.translation.rmse) + ", rotation rmse " +
             format("%.3g deg", r.rotation_deg.rmse);
   p.subtitle = viewTail(o.eval, in, r.translation.count);
   p.reference = positionsOf(r.data.ref);
