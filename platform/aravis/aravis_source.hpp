@@ -1,0 +1,67 @@
+#pragma once
+// GenICam cameras through Aravis 0.8 (GigE Vision and USB3 Vision). Per camera: opened by serial
+// number, device ID or IP address; exposure, gain and pixel format from the config; trigger from the
+// config (hardware line, software, or free-running); stream buffers allocated once and pushed once,
+// each returned to the stream right after its image is converted. One acquisition thread per camera.
+// A camera that stops delivering is reported lost and reopened until it comes back.
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "aravis/pixel_convert.hpp"
+#include "daemon/daemon_config.hpp"
+#include "realtime/alloc_meter.hpp"
+#include "sources/frame_source.hpp"
+
+typedef struct _ArvCamera ArvCamera;
+typedef struct _ArvStream ArvStream;
+
+namespace mcslam::platform {
+
+class AravisSource final : public FrameSource, private TriggerOutput {
+ public:
+  // Opens and configures every camera. Throws InputError naming source.aravis.cameras[i] when a
+  // camera is unreachable or refuses a setting.
+  explicit AravisSource(const DaemonConfig& config);
+  ~AravisSource() override;
+
+  void start(CameraRings& rings, const TriggerLog& triggers) override;
+  void stop() override;
+  TriggerOutput* softwareTrigger() override { return software_ ? this : nullptr; }
+  void health(char* out, std::size_t size) const override;
+  uint64_t allocationsSinceWarmup() const override;
+
+ private:
+  struct Camera {
+    int index = 0;
+    AravisCameraConfig cfg;
+    std::string key;  // "source.aravis.cameras[i]"
+    PixelLayout layout = PixelLayout::Mono8;
+    int width = 0, height = 0;
+    std::mutex handle_mutex;  // guards camera/stream against the trigger thread while reopening
+    ArvCamera* camera = nullptr;
+    ArvStream* stream = nullptr;
+    std::atomic<bool> lost{false};
+    bool have_first_id = false;
+    uint64_t last_frame_id = 0, index_base = 0, frames = 0;
+    int64_t last_frame_mono = 0;
+    ThreadAllocMeter meter;
+    std::thread thread;
+  };
+
+  bool fire(uint64_t index) override;
+  void open(Camera& cam);  // throws InputError
+  void close(Camera& cam);
+  void acquire(Camera& cam);
+  bool tryReopen(Camera& cam);
+
+  DaemonConfig config_;
+  bool software_;
+  std::vector<std::unique_ptr<Camera>> cameras_;
+  CameraRings* rings_ = nullptr;
+  const TriggerLog* triggers_ = nullptr;
+  std::atomic<bool> stop_{false};
+};
+
+}  // namespace mcslam::platform

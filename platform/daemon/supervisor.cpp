@@ -1,0 +1,119 @@
+#include "daemon/supervisor.hpp"
+
+#include <signal.h>
+
+#include <cstdio>
+
+#include <spdlog/spdlog.h>
+
+#include "daemon/daemon.hpp"
+#include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/pipeline/pipeline_factory.hpp"
+#include "systemd/notifier.hpp"
+
+namespace mcslam::platform {
+
+void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char* out, std::size_t size) {
+  const double per_frame = s.frames_after_warmup
+                               ? static_cast<double>(s.allocations_after_warmup) / static_cast<double>(s.frames_after_warmup)
+                               : 0.0;
+  std::snprintf(out, size,
+                "%.1f Hz, %s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
+                "cameras %s%s",
+                rate_hz, trackingStateName(s.tracking), static_cast<unsigned long long>(s.processed),
+                static_cast<unsigned long long>(s.rig_drops + s.camera_drops),
+                static_cast<unsigned long long>(s.partial_frames), static_cast<double>(s.latency_p50_ns) * 1e-6,
+                per_frame, s.warm ? "" : " (warming up)", health, s.source_finished ? ", source finished" : "");
+}
+
+int runDaemon(const DaemonConfig& config) {
+  // Block the stop signals before any thread exists, so every thread inherits the mask and only this
+  // one receives them (sigtimedwait).
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+  SystemdNotifier notifier;
+  Daemon daemon(config, createPipeline(config.slam, config.file, config.rig));
+  daemon.start();
+  notifier.ready();
+  spdlog::info("mcslamd: running ({} cameras, source {}, trigger {}, trajectory {}){}", config.rig.size(),
+               config.source_type, config.trigger.mode, daemon.trajectoryPath(),
+               notifier.enabled() ? ", systemd notified" : "");
+
+  const int64_t status_ns = static_cast<int64_t>(config.status_interval_s * 1e9);
+  const int64_t watchdog_ns = notifier.watchdogIntervalUs() * 1000 / 2;
+  const int64_t tick_ns = watchdog_ns > 0 ? std::min(status_ns, watchdog_ns) : status_ns;
+  uint64_t last_processed = 0, processed_at_status = 0;
+  int64_t last_progress = monotonicNowNs(), last_status = monotonicNowNs();
+  TrackingState last_state = TrackingState::NotInitialized;
+  uint64_t last_lost = 0;
+  bool stall_reported = false;
+  int signal_number = 0;
+
+  for (;;) {
+    timespec timeout{static_cast<time_t>(tick_ns / 1000000000), static_cast<long>(tick_ns % 1000000000)};
+    const int sig = sigtimedwait(&stop_signals, nullptr, &timeout);
+    if (sig == SIGTERM || sig == SIGINT) {
+      signal_number = sig;
+      break;
+    }
+    const int64_t now = monotonicNowNs();
+    const DaemonStats s = daemon.stats();
+    char health[128];
+    daemon.health(health, sizeof(health));
+
+    // Watchdog: only when frames were processed since the last tick (or a finished replay idles).
+    const bool progress = s.processed > last_processed;
+    if (progress) {
+      last_progress = now;
+      if (stall_reported) spdlog::info("frames flow again");
+      stall_reported = false;
+    } else if (!s.source_finished && now - last_progress > 2000000000 && !stall_reported) {
+      spdlog::warn("no frame processed for 2 s (cameras: {})", health);
+      stall_reported = true;
+    }
+    if (progress || s.source_finished) notifier.watchdog();
+    last_processed = s.processed;
+
+    if (s.tracking != last_state) {
+      if (s.tracking == TrackingState::Lost) spdlog::warn("tracking lost (frame {})", s.processed);
+      else spdlog::info("tracking state: {}", trackingStateName(s.tracking));
+      last_state = s.tracking;
+    }
+    if (s.lost_events > last_lost) {
+      spdlog::warn("camera lost events: {} ({})", s.lost_events, health);
+      last_lost = s.lost_events;
+    }
+    if (now - last_status >= status_ns) {
+      const double rate = static_cast<double>(s.processed - processed_at_status) / (static_cast<double>(now - last_status) * 1e-9);
+      char line[400];
+      formatStatus(s, rate, health, line, sizeof(line));
+      notifier.status(line);
+      spdlog::info("{}", line);
+      processed_at_status = s.processed;
+      last_status = now;
+    }
+    if (config.source_type == "dataset" && config.dataset.at_end == "exit" && daemon.drained()) {
+      spdlog::info("replay finished: stopping");
+      break;
+    }
+  }
+
+  notifier.stopping();
+  if (signal_number) spdlog::info("{}: stopping", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+  const bool clean = daemon.stop();
+  const DaemonStats s = daemon.stats();
+  spdlog::info(
+      "stopped: {} frames processed, {} poses published, {} in the trajectory ({}), {} rig frames dropped, "
+      "{} camera images dropped, {} partial, {} bad, {} allocations in {} frames after warm-up (process total {})",
+      s.processed, s.published, s.trajectory_poses, daemon.trajectoryPath(), s.rig_drops, s.camera_drops,
+      s.partial_frames, s.bad_frames, s.allocations_after_warmup, s.frames_after_warmup, alloc::totalCount());
+  spdlog::info("refined extrinsics: the pipeline provides none yet; nothing written");
+  if (!clean) spdlog::error("the pipeline did not finish its frame within the grace period");
+  return clean ? 0 : 1;
+}
+
+}  // namespace mcslam::platform

@@ -1,0 +1,17 @@
+#pragma once
+// The daemon's main thread: builds the Daemon, tells systemd READY=1, then until SIGTERM/SIGINT (or the
+// end of a replay with at_end: exit) sends STATUS= and WATCHDOG=1 (only while frames are being
+// processed), logs statistics and state changes, and finally stops everything within 2 s.
+#include "daemon/daemon_config.hpp"
+
+namespace mcslam::platform {
+
+// Returns the process exit code: 0 after a clean stop, 1 when the pipeline did not stop in time.
+// Throws InputError when start-up fails (before any thread starts).
+int runDaemon(const DaemonConfig& config);
+
+// Formats one status line ("20.0 Hz, tracking, frames 1234, dropped 0, allocs/frame 0.00").
+struct DaemonStats;
+void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char* out, std::size_t size);
+
+}  // namespace mcslam::platform

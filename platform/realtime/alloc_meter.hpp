@@ -1,0 +1,33 @@
+#pragma once
+// Counts one thread's heap allocations after the warm-up: the thread calls note() after each item;
+// once `counting` turns true the current count becomes the baseline. Others read since().
+#include <atomic>
+#include <cstdint>
+
+#include "mcslam/core/alloc_counter.hpp"
+
+namespace mcslam::platform {
+
+class ThreadAllocMeter {
+ public:
+  void note(bool counting) {
+    const uint64_t now = alloc::threadCount();
+    if (!based_.load(std::memory_order_relaxed)) {
+      if (!counting) return;
+      baseline_.store(now, std::memory_order_relaxed);
+      based_.store(true, std::memory_order_release);
+    }
+    now_.store(now, std::memory_order_relaxed);
+  }
+  uint64_t since() const {
+    if (!based_.load(std::memory_order_acquire)) return 0;
+    return now_.load(std::memory_order_relaxed) - baseline_.load(std::memory_order_relaxed);
+  }
+  bool counting() const { return based_.load(std::memory_order_acquire); }
+
+ private:
+  std::atomic<uint64_t> baseline_{0}, now_{0};
+  std::atomic<bool> based_{false};
+};
+
+}  // namespace mcslam::platform

@@ -1,0 +1,20 @@
+#pragma once
+// Thread names, realtime scheduling and memory locking (all optional, from the `realtime:` config).
+#include <string>
+
+namespace mcslam::platform {
+
+// Names the calling thread (shown by top -H and in /proc); at most 15 characters are kept.
+void nameThisThread(const char* name);
+
+// SCHED_FIFO at `priority` (1..99) for the calling thread; 0 leaves it as is. Returns an empty string
+// on success, else the reason (e.g. missing CAP_SYS_NICE / LimitRTPRIO), which the caller logs.
+std::string setRealtimePriority(int priority);
+
+// mlockall(MCL_CURRENT | MCL_FUTURE): no page faults on the hot path. Empty string on success.
+std::string lockAllMemory();
+
+// Pins the calling thread to one CPU (-1 = no pinning). Empty string on success.
+std::string pinThisThread(int cpu);
+
+}  // namespace mcslam::platform

@@ -1,0 +1,13 @@
+#pragma once
+// Creates the source named by source.type. Throws InputError (unreachable camera, missing dataset).
+#include <atomic>
+#include <memory>
+
+#include "daemon/daemon_config.hpp"
+#include "sources/frame_source.hpp"
+
+namespace mcslam::platform {
+
+std::unique_ptr<FrameSource> createSource(const DaemonConfig& config, const std::atomic<uint64_t>& processed);
+
+}  // namespace mcslam::platform

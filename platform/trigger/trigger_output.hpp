@@ -1,0 +1,40 @@
+#pragma once
+// What a trigger pulse does: toggle a GPIO line, send a software trigger to the cameras, or tell the
+// dataset replay to emit its next frame. Called from the trigger thread only.
+#include <atomic>
+#include <cstdint>
+
+namespace mcslam::platform {
+
+class TriggerOutput {
+ public:
+  virtual ~TriggerOutput() = default;
+  // Fires trigger number `index` (0, 1, 2, ...). Returns false when it failed (counted by the caller).
+  virtual bool fire(uint64_t index) = 0;
+};
+
+// Remembers when each recent trigger fired (CLOCK_MONOTONIC), so the frame it produced can be traced
+// back to it for the trigger-to-pose latency. Fixed ring; lock-free; one writer.
+class TriggerLog {
+ public:
+  static constexpr uint32_t kSize = 4096;
+  void record(uint64_t index, int64_t mono_ns) {
+    entries_[index % kSize].index.store(index, std::memory_order_relaxed);
+    entries_[index % kSize].mono_ns.store(mono_ns, std::memory_order_release);
+  }
+  // 0 when that trigger is unknown or already overwritten.
+  int64_t lookup(uint64_t index) const {
+    const Entry& e = entries_[index % kSize];
+    const int64_t t = e.mono_ns.load(std::memory_order_acquire);
+    return e.index.load(std::memory_order_relaxed) == index ? t : 0;
+  }
+
+ private:
+  struct Entry {
+    std::atomic<uint64_t> index{~0ull};
+    std::atomic<int64_t> mono_ns{0};
+  };
+  Entry entries_[kSize];
+};
+
+}  // namespace mcslam::platform
