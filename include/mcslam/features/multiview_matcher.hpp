@@ -1,0 +1,82 @@
+#pragma once
+// Multi-view features (paper section IV-A): cell-wise cross matching between overlapping cameras of
+// one rig frame, an epipolar gate in angular form (valid for any lens and rig orientation), merging of
+// the pairwise matches into tracks with at most one keypoint per camera, and triangulation from all
+// rays with depth, reprojection and uncertainty checks.
+#include <cstdint>
+#include <vector>
+
+#include "mcslam/calib/rig.hpp"
+#include "mcslam/features/frame_features.hpp"
+#include "mcslam/features/overlap_map.hpp"
+#include "mcslam/geometry/triangulation.hpp"
+
+namespace mcslam {
+
+struct MultiViewOptions {
+  int max_hamming = 60;             // accept a match only below this descriptor distance (of 256 bits)
+  float ratio = 0.8f;               // best / second best among epipolar-consistent candidates
+  double epipolar_px = 2.0;         // gate, in pixels at octave 0 (scaled by the keypoint's octave sigma)
+  float octave_scale = 1.2f;        // pyramid scale factor: sigma = scale^octave
+  int max_octave_difference = 2;    // scale consistency between the two keypoints
+  TriangulationOptions triangulation;
+};
+
+struct MultiViewStats {
+  int pair_matches = 0;     // accepted pairwise matches
+  int tracks = 0;           // multi-view features
+  int tracks_with_point = 0;
+  int dropped = 0;          // tracks rejected by geometry
+};
+
+class MultiViewMatcher {
+ public:
+  // Everything is allocated here, for at most `max_features_per_camera` keypoints per camera.
+  MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, const MultiViewOptions& options,
+                   int max_features_per_camera);
+
+  // Computes bearings for every keypoint, then the multi-view features. No heap allocation.
+  void compute(FrameFeatures& frame);
+  const MultiViewStats& stats() const { return stats_; }
+
+ private:
+  struct Match {
+    int16_t cam_a, cam_b;
+    int32_t kp_a, kp_b;
+    int16_t distance;
+  };
+  void computeBearings(FrameFeatures& f);
+  void bucketKeypoints(const FrameFeatures& f);
+  void matchPair(const FrameFeatures& f, int i, int j);
+  void mergeTracks(FrameFeatures& f);
+  void finishTrack(FrameFeatures& f, int first, int size);
+  int find(int node);
+
+  const Rig& rig_;
+  const OverlapMap& overlap_;
+  MultiViewOptions options_;
+  int capacity_;
+  MultiViewStats stats_;
+
+  // Keypoints bucketed by cell, per camera (counting sort).
+  std::vector<std::vector<int32_t>> cell_start_;  // cells + 1
+  std::vector<std::vector<int32_t>> cell_items_;
+  std::vector<std::vector<int32_t>> cell_of_;     // per keypoint
+
+  // Pairwise matches and their merge.
+  std::vector<Match> matches_;
+  int match_count_ = 0;
+  std::vector<int32_t> best_for_b_;      // per keypoint of camera j: best keypoint of camera i
+  std::vector<int16_t> best_dist_for_b_;
+  std::vector<int32_t> parent_;          // union-find over (camera, keypoint) nodes
+  std::vector<uint64_t> camera_mask_;    // per root: cameras already in the component
+  std::vector<int32_t> order_;           // matches sorted by distance
+  std::vector<int32_t> distance_count_;  // counting sort buckets (257)
+  std::vector<int32_t> component_of_root_;
+  std::vector<int32_t> component_size_;
+  std::vector<int32_t> members_;         // nodes grouped by component
+  std::vector<TriangulationObservation> scratch_obs_;
+  std::vector<Vec3> epipolar_normals_;   // per keypoint of camera i, in camera j's frame
+};
+
+}  // namespace mcslam

@@ -1,0 +1,314 @@
+#include "mcslam/features/multiview_matcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mcslam/core/error.hpp"
+
+namespace mcslam {
+
+void FrameFeatures::allocate(int cameras, int max_features_per_camera) {
+  capacity_ = max_features_per_camera;
+  present.assign(cameras, 0);
+  sets.assign(cameras, FeatureSet(max_features_per_camera));
+  bearings.assign(cameras, std::vector<Vec3>(max_features_per_camera));
+  valid.assign(cameras, std::vector<uint8_t>(max_features_per_camera));
+  mv_of.assign(cameras, std::vector<int32_t>(max_features_per_camera, -1));
+  mv.resize(std::max(1, cameras * max_features_per_camera / 2));
+  mv_refs.resize(std::max(1, cameras * max_features_per_camera));
+  clear();
+}
+
+void FrameFeatures::clear() {
+  for (FeatureSet& s : sets) s.clear();
+  std::fill(present.begin(), present.end(), 0);
+  mv_count = 0;
+  mv_ref_count = 0;
+}
+
+int FrameFeatures::keypointCount() const {
+  int n = 0;
+  for (const FeatureSet& s : sets) n += s.count;
+  return n;
+}
+
+int FrameFeatures::monoCount() const {
+  int n = 0;
+  for (int c = 0; c < cameras(); ++c) {
+    for (int k = 0; k < sets[c].count; ++k) n += mv_of[c][k] < 0 ? 1 : 0;
+  }
+  return n;
+}
+
+namespace {
+constexpr int kMaxOctaves = 32;
+}
+
+MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, const MultiViewOptions& options,
+                                   int max_features_per_camera)
+    : rig_(rig), overlap_(overlap), options_(options), capacity_(max_features_per_camera) {
+  const int n = rig.size();
+  if (n > 64) throw InputError("multi-view features support at most 64 cameras per rig");
+  cell_start_.resize(n);
+  cell_items_.resize(n);
+  cell_of_.resize(n);
+  for (int c = 0; c < n; ++c) {
+    cell_start_[c].resize(overlap.grid(c).cells() + 1);
+    cell_items_[c].resize(capacity_);
+    cell_of_[c].resize(capacity_);
+  }
+  const std::size_t pairs = overlap.overlappingPairs().size();
+  matches_.resize(std::max<std::size_t>(1, pairs * capacity_));
+  order_.resize(matches_.size());
+  best_for_b_.resize(capacity_);
+  best_dist_for_b_.resize(capacity_);
+  epipolar_normals_.resize(capacity_);
+  parent_.resize(static_cast<std::size_t>(n) * capacity_);
+  camera_mask_.resize(parent_.size());
+  component_of_root_.resize(parent_.size());
+  component_size_.resize(parent_.size());
+  members_.resize(parent_.size());
+  distance_count_.resize(258);
+  scratch_obs_.resize(n);
+}
+
+void MultiViewMatcher::compute(FrameFeatures& f) {
+  stats_ = MultiViewStats{};
+  f.mv_count = 0;
+  f.mv_ref_count = 0;
+  computeBearings(f);
+  bucketKeypoints(f);
+  match_count_ = 0;
+  for (const auto& [i, j] : overlap_.overlappingPairs()) {
+    if (f.present[i] && f.present[j]) matchPair(f, i, j);
+  }
+  stats_.pair_matches = match_count_;
+  mergeTracks(f);
+}
+
+void MultiViewMatcher::computeBearings(FrameFeatures& f) {
+  for (int c = 0; c < f.cameras(); ++c) {
+    const CameraModel& model = rig_.model(c);
+    const FeatureSet& s = f.sets[c];
+    for (int k = 0; k < s.count; ++k) {
+      f.valid[c][k] = model.unproject(Vec2(s.keypoints[k].x, s.keypoints[k].y), f.bearings[c][k]) ? 1 : 0;
+      f.mv_of[c][k] = -1;
+    }
+  }
+}
+
+void MultiViewMatcher::bucketKeypoints(const FrameFeatures& f) {
+  for (int c = 0; c < f.cameras(); ++c) {
+    const CellGrid& g = overlap_.grid(c);
+    std::vector<int32_t>& start = cell_start_[c];
+    std::fill(start.begin(), start.end(), 0);
+    const FeatureSet& s = f.sets[c];
+    for (int k = 0; k < s.count; ++k) {
+      const int cell = g.cellOf(s.keypoints[k].x, s.keypoints[k].y);
+      cell_of_[c][k] = cell;
+      if (cell >= 0) ++start[cell + 1];
+    }
+    for (int i = 0; i < g.cells(); ++i) start[i + 1] += start[i];
+    // Fill using the start offsets as cursors, then shift them back.
+    for (int k = 0; k < s.count; ++k) {
+      if (cell_of_[c][k] >= 0) cell_items_[c][start[cell_of_[c][k]]++] = k;
+    }
+    for (int i = g.cells(); i > 0; --i) start[i] = start[i - 1];
+    start[0] = 0;
+  }
+}
+
+void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
+  const SE3 T_j_i = rig_.T_b_c(j).inverse() * rig_.T_b_c(i);
+  const FeatureSet& si = f.sets[i];
+  const FeatureSet& sj = f.sets[j];
+  const double fj = 0.5 * (rig_.model(j).fx() + rig_.model(j).fy());
+  double gate[kMaxOctaves];  // sine of the largest angle to the epipolar plane, per octave of the keypoint in j
+  for (int o = 0; o < kMaxOctaves; ++o) gate[o] = options_.epipolar_px * std::pow(options_.octave_scale, o) / fj;
+
+  std::fill(best_for_b_.begin(), best_for_b_.begin() + sj.count, -1);
+  std::fill(best_dist_for_b_.begin(), best_dist_for_b_.begin() + sj.count, int16_t{257});
+  const int first_match = match_count_;
+
+  for (int a = 0; a < si.count; ++a) {
+    if (!f.valid[i][a] || cell_of_[i][a] < 0) continue;
+    // Normal of the epipolar plane of keypoint a, in camera j: the baseline crossed with its ray.
+    Vec3 n = T_j_i.t.cross(T_j_i.R * f.bearings[i][a]);
+    const double nn = n.norm();
+    if (nn < 1e-12) continue;  // the ray passes through camera j's centre
+    n /= nn;
+    const Descriptor& da = si.descriptors[a];
+    const int oa = si.keypoints[a].octave;
+    int best = 257, second = 257, best_b = -1;
+    for (const int32_t cell : overlap_.candidates(i, j, cell_of_[i][a])) {
+      for (int32_t idx = cell_start_[j][cell]; idx < cell_start_[j][cell + 1]; ++idx) {
+        const int b = cell_items_[j][idx];
+        if (!f.valid[j][b]) continue;
+        const int ob = sj.keypoints[b].octave;
+        if (std::abs(oa - ob) > options_.max_octave_difference) continue;
+        if (std::abs(n.dot(f.bearings[j][b])) > gate[std::min(ob, kMaxOctaves - 1)]) continue;
+        const int d = hammingDistance(da, sj.descriptors[b]);
+        if (d < best) {
+          second = best;
+          best = d;
+          best_b = b;
+        } else if (d < second) {
+          second = d;
+        }
+        if (d < best_dist_for_b_[b]) {
+          best_dist_for_b_[b] = static_cast<int16_t>(d);
+          best_for_b_[b] = a;
+        }
+      }
+    }
+    if (best_b < 0 || best > options_.max_hamming || !(best < options_.ratio * second)) continue;
+    matches_[match_count_++] = Match{static_cast<int16_t>(i), static_cast<int16_t>(j), a, best_b,
+                                     static_cast<int16_t>(best)};
+  }
+  // Keep only mutual best matches: b's best keypoint of camera i must be a.
+  int kept = first_match;
+  for (int m = first_match; m < match_count_; ++m) {
+    if (best_for_b_[matches_[m].kp_b] == matches_[m].kp_a) matches_[kept++] = matches_[m];
+  }
+  match_count_ = kept;
+}
+
+int MultiViewMatcher::find(int node) {
+  while (parent_[node] != node) {
+    parent_[node] = parent_[parent_[node]];  // path halving
+    node = parent_[node];
+  }
+  return node;
+}
+
+void MultiViewMatcher::mergeTracks(FrameFeatures& f) {
+  const int cams = f.cameras();
+  for (int c = 0; c < cams; ++c) {
+    for (int k = 0; k < f.sets[c].count; ++k) {
+      const int node = c * capacity_ + k;
+      parent_[node] = node;
+      camera_mask_[node] = uint64_t{1} << c;
+      component_size_[node] = 0;
+    }
+  }
+  // Best matches first (counting sort on the distance): a conflicting later match is the one dropped.
+  std::fill(distance_count_.begin(), distance_count_.end(), 0);
+  for (int m = 0; m < match_count_; ++m) ++distance_count_[matches_[m].distance + 1];
+  for (int d = 0; d < 257; ++d) distance_count_[d + 1] += distance_count_[d];
+  for (int m = 0; m < match_count_; ++m) order_[distance_count_[matches_[m].distance]++] = m;
+
+  for (int o = 0; o < match_count_; ++o) {
+    const Match& m = matches_[order_[o]];
+    const int ra = find(m.cam_a * capacity_ + m.kp_a);
+    const int rb = find(m.cam_b * capacity_ + m.kp_b);
+    if (ra == rb) continue;
+    if (camera_mask_[ra] & camera_mask_[rb]) continue;  // would put two keypoints of one camera in a track
+    parent_[rb] = ra;
+    camera_mask_[ra] |= camera_mask_[rb];
+  }
+
+  // Components of two or more keypoints become tracks, listed in keypoint order: count, place, emit.
+  int total = 0;
+  for (int c = 0; c < cams; ++c) {
+    for (int k = 0; k < f.sets[c].count; ++k) ++component_size_[find(c * capacity_ + k)];
+  }
+  for (int c = 0; c < cams; ++c) {
+    for (int k = 0; k < f.sets[c].count; ++k) {
+      const int node = c * capacity_ + k;
+      if (find(node) == node && component_size_[node] >= 2) {
+        component_of_root_[node] = total;  // start of its members
+        total += component_size_[node];
+      }
+    }
+  }
+  // component_of_root_ serves as each component's fill cursor, in keypoint order.
+  int placed = 0;
+  for (int c = 0; c < cams; ++c) {
+    for (int k = 0; k < f.sets[c].count; ++k) {
+      const int root = find(c * capacity_ + k);
+      if (component_size_[root] < 2) continue;
+      members_[component_of_root_[root]++] = c * capacity_ + k;
+      ++placed;
+    }
+  }
+  for (int m = 0; m < placed;) {
+    const int size = component_size_[find(members_[m])];
+    const int first = f.mv_ref_count;
+    for (int s = 0; s < size; ++s) {
+      const int node = members_[m + s];
+      f.mv_refs[first + s] = KeypointRef{static_cast<int16_t>(node / capacity_), node % capacity_};
+    }
+    finishTrack(f, first, size);
+    m += size;
+  }
+}
+
+void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
+  auto fillObservations = [&](int n) {
+    for (int s = 0; s < n; ++s) {
+      const KeypointRef& r = f.mv_refs[first + s];
+      const Keypoint& kp = f.sets[r.cam].keypoints[r.index];
+      TriangulationObservation& o = scratch_obs_[s];
+      o.model = &rig_.model(r.cam);
+      o.T_f_c = rig_.T_b_c(r.cam);
+      o.uv = Vec2(kp.x, kp.y);
+      o.bearing = f.bearings[r.cam][r.index];
+      o.sigma_px = std::pow(options_.octave_scale, kp.octave);
+    }
+  };
+  TriangulationResult tri;
+  for (;;) {
+    fillObservations(size);
+    tri = triangulate(scratch_obs_.data(), size, options_.triangulation);
+    if (tri.status != TriangulationStatus::LargeReprojection || size <= 2) break;
+    // One keypoint disagrees: drop the worst and try again.
+    int worst = 0;
+    double worst_err = -1;
+    for (int s = 0; s < size; ++s) {
+      const TriangulationObservation& o = scratch_obs_[s];
+      Vec2 uv;
+      const double e = o.model->project(o.T_f_c.inverse() * tri.point, uv) ? (uv - o.uv).norm() / o.sigma_px : 1e9;
+      if (e > worst_err) {
+        worst_err = e;
+        worst = s;
+      }
+    }
+    std::swap(f.mv_refs[first + worst], f.mv_refs[first + size - 1]);
+    --size;
+  }
+  const bool keep = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain ||
+                    tri.status == TriangulationStatus::LowParallax;
+  if (!keep) {
+    ++stats_.dropped;
+    return;  // its keypoints stay mono features
+  }
+  MultiViewFeature& mv = f.mv[f.mv_count];
+  mv.first = first;
+  mv.size = static_cast<int16_t>(size);
+  mv.has_point = tri.status == TriangulationStatus::Ok;
+  mv.p_b = tri.point;
+  mv.relative_depth_sigma = static_cast<float>(tri.relative_depth_sigma);
+  // Representative descriptor: the medoid (least total Hamming distance to the others).
+  int best = 0, best_sum = 1 << 30;
+  for (int a = 0; a < size; ++a) {
+    const KeypointRef& ra = f.mv_refs[first + a];
+    int sum = 0;
+    for (int b = 0; b < size; ++b) {
+      const KeypointRef& rb = f.mv_refs[first + b];
+      sum += hammingDistance(f.sets[ra.cam].descriptors[ra.index], f.sets[rb.cam].descriptors[rb.index]);
+    }
+    if (sum < best_sum) {
+      best_sum = sum;
+      best = a;
+    }
+  }
+  const KeypointRef& rm = f.mv_refs[first + best];
+  mv.descriptor = f.sets[rm.cam].descriptors[rm.index];
+  for (int s = 0; s < size; ++s) f.mv_of[f.mv_refs[first + s].cam][f.mv_refs[first + s].index] = f.mv_count;
+  ++f.mv_count;
+  f.mv_ref_count += size;
+  ++stats_.tracks;
+  stats_.tracks_with_point += mv.has_point ? 1 : 0;
+}
+
+}  // namespace mcslam

@@ -1,0 +1,172 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/features/multiview_matcher.hpp"
+#include "synthetic_rigs.hpp"
+
+using namespace mcslam;
+
+namespace {
+
+constexpr int kCapacity = 1200;
+
+// Keypoints of a synthetic scene: each point gets a random descriptor, seen in a camera as that descriptor
+// with a few flipped bits and a noisy pixel; plus distractor keypoints with unrelated descriptors.
+// truth[c][k] = scene point index or -1.
+struct SyntheticFrame {
+  FrameFeatures features;
+  std::vector<std::vector<int>> truth;
+  std::vector<test::ScenePoint> scene;
+};
+
+SyntheticFrame makeFrame(const Rig& rig, int points, int distractors, double noise_px, std::mt19937& rng) {
+  SyntheticFrame s;
+  s.features.allocate(rig.size(), kCapacity);
+  s.truth.assign(rig.size(), {});
+  s.scene = test::randomScene(rig, points, 1.0, 25.0, rng);
+  std::uniform_int_distribution<uint64_t> bits;
+  std::uniform_int_distribution<int> bit(0, 255), octave(0, 2);
+  std::normal_distribution<double> noise(0.0, noise_px);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Descriptor> base(s.scene.size());
+  std::vector<int> point_octave(s.scene.size());
+  for (std::size_t p = 0; p < s.scene.size(); ++p) {
+    for (auto& w : base[p]) w = bits(rng);
+    point_octave[p] = octave(rng);
+  }
+  for (int c = 0; c < rig.size(); ++c) {
+    struct Item { Keypoint kp; Descriptor d; int truth; };
+    std::vector<Item> items;
+    for (std::size_t p = 0; p < s.scene.size(); ++p) {
+      if (!s.scene[p].visible[c]) continue;
+      Item it;
+      it.kp.x = static_cast<float>(s.scene[p].uv[c].x() + noise(rng));
+      it.kp.y = static_cast<float>(s.scene[p].uv[c].y() + noise(rng));
+      it.kp.octave = static_cast<int8_t>(point_octave[p]);
+      it.d = base[p];
+      for (int f = 0; f < 12; ++f) {
+        const int b = bit(rng);
+        it.d[b / 64] ^= uint64_t{1} << (b % 64);
+      }
+      it.truth = static_cast<int>(p);
+      items.push_back(it);
+    }
+    for (int k = 0; k < distractors; ++k) {
+      Item it;
+      it.kp.x = static_cast<float>(u(rng) * (rig.model(c).width() - 1));
+      it.kp.y = static_cast<float>(u(rng) * (rig.model(c).height() - 1));
+      for (auto& w : it.d) w = bits(rng);
+      it.truth = -1;
+      items.push_back(it);
+    }
+    std::shuffle(items.begin(), items.end(), rng);
+    items.resize(std::min<std::size_t>(items.size(), kCapacity));
+    FeatureSet& set = s.features.sets[c];
+    set.count = static_cast<int>(items.size());
+    for (std::size_t k = 0; k < items.size(); ++k) {
+      set.keypoints[k] = items[k].kp;
+      set.descriptors[k] = items[k].d;
+      s.truth[c].push_back(items[k].truth);
+    }
+    s.features.present[c] = 1;
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(MultiViewMatcher, FindsTheTrueTracksWithMetricDepth) {
+  const Rig rig = test::isecRig();
+  const OverlapMap overlap(rig, OverlapOptions{});
+  MultiViewOptions opt;
+  MultiViewMatcher matcher(rig, overlap, opt, kCapacity);
+  std::mt19937 rng(21);
+  SyntheticFrame s = makeFrame(rig, 700, 200, 0.3, rng);
+  matcher.compute(s.features);
+  const FrameFeatures& f = s.features;
+
+  int pure = 0, with_point = 0, depth_ok = 0;
+  std::vector<int> found(s.scene.size(), 0);
+  for (int t = 0; t < f.mv_count; ++t) {
+    const MultiViewFeature& mv = f.mv[t];
+    uint64_t cams = 0;
+    const int p0 = s.truth[f.mv_refs[mv.first].cam][f.mv_refs[mv.first].index];
+    bool same = p0 >= 0;
+    for (int k = 0; k < mv.size; ++k) {
+      const KeypointRef& r = f.mv_refs[mv.first + k];
+      EXPECT_FALSE(cams & (uint64_t{1} << r.cam)) << "two keypoints of one camera in a track";
+      cams |= uint64_t{1} << r.cam;
+      EXPECT_EQ(f.mv_of[r.cam][r.index], t);
+      same = same && s.truth[r.cam][r.index] == p0;
+    }
+    pure += same ? 1 : 0;
+    if (same) found[p0] = 1;
+    if (mv.has_point) {
+      ++with_point;
+      if (same) {
+        const Vec3 truth = s.scene[p0].p_b;
+        depth_ok += std::abs(mv.p_b.norm() - truth.norm()) < 0.02 * truth.norm() ? 1 : 0;
+      }
+    }
+  }
+  int seen_twice = 0, recovered = 0;
+  for (std::size_t p = 0; p < s.scene.size(); ++p) {
+    const int views = static_cast<int>(std::count(s.scene[p].visible.begin(), s.scene[p].visible.end(), true));
+    if (views >= 2) {
+      ++seen_twice;
+      recovered += found[p];
+    }
+  }
+  ASSERT_GT(f.mv_count, 100);
+  EXPECT_GE(pure, 0.99 * f.mv_count) << pure << " of " << f.mv_count;
+  EXPECT_GE(recovered, 0.9 * seen_twice) << recovered << " of " << seen_twice;
+  EXPECT_GT(with_point, f.mv_count / 2);
+  EXPECT_GE(depth_ok, 0.98 * with_point) << depth_ok << " of " << with_point;
+  EXPECT_EQ(matcher.stats().tracks, f.mv_count);
+  // Distractors have no partner: they stay mono features.
+  int distractor_in_track = 0, distractors = 0;
+  for (int c = 0; c < f.cameras(); ++c) {
+    for (int k = 0; k < f.sets[c].count; ++k) {
+      if (s.truth[c][k] >= 0) continue;
+      ++distractors;
+      distractor_in_track += f.mv_of[c][k] >= 0 ? 1 : 0;
+    }
+  }
+  EXPECT_LT(distractor_in_track, 0.01 * distractors);
+  EXPECT_EQ(f.monoCount() + f.mv_ref_count, f.keypointCount());
+}
+
+TEST(MultiViewMatcher, NonOverlappingRigHasOnlyMonoFeatures) {
+  const Rig rig = test::ring8Rig(70.0).subset({0, 2, 4, 6});
+  OverlapOptions oo;
+  oo.min_depth = 1.0;
+  const OverlapMap overlap(rig, oo);
+  EXPECT_TRUE(overlap.overlappingPairs().empty());
+  MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, kCapacity);
+  std::mt19937 rng(22);
+  SyntheticFrame s = makeFrame(rig, 400, 100, 0.3, rng);
+  matcher.compute(s.features);
+  EXPECT_EQ(s.features.mv_count, 0);
+  EXPECT_EQ(s.features.monoCount(), s.features.keypointCount());
+}
+
+TEST(MultiViewMatcher, AbsentCameraAndNoAllocationAfterWarmUp) {
+  const Rig rig = test::isecRig();
+  const OverlapMap overlap(rig, OverlapOptions{});
+  MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, kCapacity);
+  std::mt19937 rng(23);
+  SyntheticFrame s = makeFrame(rig, 500, 100, 0.3, rng);
+  matcher.compute(s.features);  // warm-up
+  s.features.present[2] = 0;    // camera 2 lost this frame
+  alloc::ThreadScope scope;
+  matcher.compute(s.features);
+  EXPECT_EQ(scope.count(), 0u);
+  for (int t = 0; t < s.features.mv_count; ++t) {
+    const MultiViewFeature& mv = s.features.mv[t];
+    for (int k = 0; k < mv.size; ++k) EXPECT_NE(s.features.mv_refs[mv.first + k].cam, 2);
+  }
+  EXPECT_GT(s.features.mv_count, 50);
+}
