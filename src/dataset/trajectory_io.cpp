@@ -63,6 +63,14 @@ std::string formatNs(Timestamp t) {
   return buf;
 }
 
+std::size_t countWords(const std::string& line) {
+  std::istringstream in(line);
+  std::string w;
+  std::size_t n = 0;
+  while (in >> w) ++n;
+  return n;
+}
+
 double parseNumber(const std::string& tok, const std::string& where, const char* what) {
   char* end = nullptr;
   const double v = std::strtod(tok.c_str(), &end);
@@ -90,7 +98,9 @@ Trajectory parseTumTrajectory(const std::string& text, const std::string& source
     std::string extra;
     while (n < 8 && ls >> tok[n]) ++n;
     if (n != 8 || (ls >> extra)) {
-      throw InputError(lineRef(source, line_no) + ": expected 8 values 't tx ty tz qx qy qz qw', got '" + line + "'");
+      const std::size_t count = countWords(line);
+      throw InputError(lineRef(source, line_no) + ": expected 8 values 't tx ty tz qx qy qz qw', got '" + line + "'" +
+                       (count == 12 ? " (12 numbers: a KITTI pose line? use the kitti format)" : ""));
     }
     StampedPose p;
     if (!parseSecondsToNs(tok[0], p.t)) {
@@ -131,26 +141,34 @@ void writeTumTrajectory(const std::string& path, const Trajectory& traj) {
   if (!out) throw InputError(path + ": write failed");
 }
 
-Trajectory readKittiTrajectory(const std::string& path, const std::string& times_path) {
+std::vector<Timestamp> readTimesFile(const std::string& path) {
   std::vector<Timestamp> times;
-  if (!times_path.empty()) {
-    std::istringstream tin(readTextFile(times_path));
-    std::string tok;
-    int line_no = 0;
-    while (tin >> tok) {
-      ++line_no;
-      Timestamp t;
-      if (!parseSecondsToNs(tok, t)) throw InputError(lineRef(times_path, line_no) + ": time is not a number: '" + tok + "'");
-      times.push_back(t);
-    }
+  std::istringstream in(readTextFile(path));
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream ls(line);
+    std::string tok, extra;
+    if (!(ls >> tok) || tok[0] == '#') continue;
+    Timestamp t;
+    if (!parseSecondsToNs(tok, t)) throw InputError(lineRef(path, line_no) + ": time is not a number: '" + tok + "'");
+    if (ls >> extra) throw InputError(lineRef(path, line_no) + ": expected one time in seconds, got '" + line + "'");
+    times.push_back(t);
   }
+  return times;
+}
+
+Trajectory readKittiTrajectory(const std::string& path, const std::string& times_path) {
+  const std::vector<Timestamp> times = times_path.empty() ? std::vector<Timestamp>() : readTimesFile(times_path);
   Trajectory traj;
   std::istringstream in(readTextFile(path));
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
     std::istringstream ls(line);
     std::string tok;
     double v[12];
@@ -160,7 +178,10 @@ Trajectory readKittiTrajectory(const std::string& path, const std::string& times
       v[n] = parseNumber(tok, lineRef(path, line_no), "matrix entry");
       ++n;
     }
-    if (n != 12) throw InputError(lineRef(path, line_no) + ": expected 12 numbers (3x4 row-major), got " + std::to_string(n));
+    if (n != 12) {
+      throw InputError(lineRef(path, line_no) + ": expected 12 numbers (3x4 row-major), got " + std::to_string(n) +
+                       (n == 8 ? " (8 numbers: a TUM line? use the tum format)" : ""));
+    }
     Mat4 M = Mat4::Identity();
     for (int k = 0; k < 12; ++k) M(k / 4, k % 4) = v[k];
     const Mat3 R = M.topLeftCorner<3, 3>();

@@ -7,7 +7,8 @@
 //    pose of the body in the world).
 //  - EuRoC: mav0/camN/{sensor.yaml,data.csv,data/}, mav0/state_groundtruth_estimate0/data.csv
 //    (IMU poses, converted into our body frame = cam0).
-//  - KITTI odometry: image_0/, image_1/ (PNG), calib.txt (P0..P3), times.txt, optional poses file.
+//  - KITTI odometry: image_0/, image_1/ (and image_2/, image_3/) PNG, calib.txt (P0..P3), times.txt, optional
+//    poses file (cam0 poses): poses.txt in the folder, ../../poses/<sequence>.txt, or given in the options.
 // Images of different cameras are assembled into rig frames by timestamp within a tolerance; a camera
 // without an image at some time gives a rig frame without that camera, never a shifted pairing.
 #include <optional>
@@ -23,7 +24,8 @@ namespace mcslam {
 struct RigFrameEntry {
   Timestamp t = 0;                       // rig frame time (the earliest camera stamp of the frame)
   std::vector<std::string> image_paths;  // one per camera of the rig; empty when that camera has none
-  std::vector<Timestamp> camera_stamps;  // one per camera; 0 when absent
+  std::vector<Timestamp> camera_stamps;  // one per camera; 0 when absent (a present stamp may be 0 too, e.g.
+                                         // KITTI's first frame: test image_paths for presence)
 };
 
 struct DatasetOptions {
@@ -34,6 +36,9 @@ struct DatasetOptions {
   // Largest difference between stamps of one rig frame; 0 = automatic (a third of the median frame period,
   // at most 5 ms).
   Timestamp sync_tolerance_ns = 0;
+  // Ground truth file to use instead of the dataset's own: TUM (body pose in the world) for ASL and EuRoC,
+  // KITTI poses (cam0, times from times.txt) for KITTI.
+  std::string ground_truth_path;
 };
 
 class Dataset {
@@ -48,6 +53,10 @@ class Dataset {
   std::size_t size() const { return frames_.size(); }
   // Ground truth in our body frame, when the dataset has it.
   const std::optional<Trajectory>& groundTruth() const { return ground_truth_; }
+  // The file the ground truth came from (empty without ground truth).
+  const std::string& groundTruthPath() const { return ground_truth_path_; }
+  // The tolerance used to assemble rig frames (the option, or the automatic choice).
+  Timestamp syncToleranceNs() const { return sync_tolerance_ns_; }
   // Problems met while indexing (e.g. a camera listing a missing file); the frames stay usable.
   const std::vector<std::string>& warnings() const { return warnings_; }
 
@@ -62,9 +71,15 @@ class Dataset {
   Rig rig_;
   std::vector<RigFrameEntry> frames_;
   std::optional<Trajectory> ground_truth_;
+  std::string ground_truth_path_;
+  Timestamp sync_tolerance_ns_ = 0;
   std::vector<std::string> warnings_;
   friend class DatasetBuilder;
 };
+
+// A rig from any calibration source: a Kalibr camchain YAML, an EuRoC sensor.yaml (one camera), a KITTI
+// calib.txt, or a dataset folder (its own calibration, as Dataset::open reads it). Throws InputError.
+Rig loadRigFromPath(const std::string& path);
 
 // Writes a dataset in the native ASL layout (what mcslam-sim produces).
 class AslDatasetWriter {

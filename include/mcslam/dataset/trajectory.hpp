@@ -28,6 +28,9 @@ std::string formatTumTrajectory(const Trajectory& traj);
 Trajectory readKittiTrajectory(const std::string& path, const std::string& times_path = "");
 void writeKittiTrajectory(const std::string& path, const Trajectory& traj);
 
+// A times file (KITTI's times.txt): one time in seconds per line, parsed exactly to the nanosecond.
+std::vector<Timestamp> readTimesFile(const std::string& path);
+
 // Either format by name ("tum" or "kitti").
 Trajectory readTrajectory(const std::string& path, const std::string& format);
 
