@@ -2,6 +2,8 @@
 
 #include <time.h>
 
+#include <algorithm>
+
 #include <spdlog/spdlog.h>
 
 #include "mcslam/core/time.hpp"
@@ -29,7 +31,8 @@ void TriggerThread::run() {
   TriggerSchedule schedule(monotonicNowNs() + period_ns_, period_ns_);
   uint64_t index = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
-    const int64_t deadline = schedule.nextDeadline();
+    // Sleep to the deadline, but at most 100 ms at a time so that stop() is prompt at low rates.
+    const int64_t deadline = std::min(schedule.nextDeadline(), monotonicNowNs() + 100000000);
     timespec ts{static_cast<time_t>(deadline / 1000000000), static_cast<long>(deadline % 1000000000)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
     const int64_t now = monotonicNowNs();

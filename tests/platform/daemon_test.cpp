@@ -1,0 +1,246 @@
+// The daemon in-process: every published pose reaches shared memory, UDP and (when valid) the trajectory
+// file identically; processing falling behind drops the oldest rig frames (counted) without ever
+// stalling the replay; the software trigger drives the replay; and after warm-up no daemon thread
+// allocates, over thousands of frames.
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "daemon/daemon.hpp"
+#include "daemon/daemon_config.hpp"
+#include "daemon_fixture.hpp"
+#include "mcslam/pipeline/pipeline_factory.hpp"
+#include "mcslam/pose_shm.hpp"
+#include "test_support.hpp"
+
+using namespace mcslam;
+using namespace mcslam::platform;
+
+namespace {
+
+// Reports a valid pose derived from the frame, so the trajectory has content; optionally slow.
+class FakeProcessor : public FrameProcessor {
+ public:
+  explicit FakeProcessor(int delay_ms = 0) : delay_ms_(delay_ms) {}
+  void process(const RigFrameView& f, PoseEstimate& out) override {
+    if (delay_ms_) std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms_));
+    out = PoseEstimate{};
+    out.t = f.t;
+    out.sequence = f.sequence;
+    out.T_w_b = SE3(so3Exp(Vec3(0, 0.01 * static_cast<double>(f.sequence), 0)),
+                    Vec3(0.1 * static_cast<double>(f.sequence), -1.0 / 3.0, 0.5));
+    out.state = f.sequence % 7 == 3 ? TrackingState::Lost : TrackingState::Tracking;
+    out.valid = out.state == TrackingState::Tracking;
+    out.quality = 0.9f;
+    out.is_keyframe = f.sequence % 5 == 0;
+  }
+
+ private:
+  int delay_ms_;
+};
+
+int udpReceiver(int& port) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
+  socklen_t len = sizeof(a);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  port = ntohs(a.sin_port);
+  int big = 4 << 20;
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &big, sizeof(big));
+  timeval tv{0, 200000};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+  return fd;
+}
+
+std::vector<pose::PoseRecord> drainUdp(int fd) {
+  std::vector<pose::PoseRecord> out;
+  uint8_t buf[512];
+  for (;;) {
+    const ssize_t n = ::recv(fd, buf, sizeof(buf), 0);
+    if (n <= 0) break;
+    pose::PoseRecord r;
+    if (pose::decodePacket(buf, static_cast<std::size_t>(n), r) == pose::DecodeStatus::Ok) out.push_back(r);
+  }
+  return out;
+}
+
+// Lines of a TUM file as (time text, 7 doubles).
+std::vector<std::pair<std::string, std::vector<double>>> readTum(const std::string& path) {
+  std::vector<std::pair<std::string, std::vector<double>>> rows;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    std::pair<std::string, std::vector<double>> row;
+    s >> row.first;
+    double v;
+    while (s >> v) row.second.push_back(v);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string tumTime(int64_t ns) {
+  char b[32];
+  std::snprintf(b, sizeof(b), "%lld.%09lld", static_cast<long long>(ns / 1000000000),
+                static_cast<long long>(ns % 1000000000));
+  return b;
+}
+
+template <typename Pred>
+bool waitFor(Pred pred, int seconds = 60) {  // liveness only
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+class DaemonTest : public ::testing::Test {
+ protected:
+  DaemonConfig config(const std::string& dataset, const std::string& extra, const std::string& shm = "") {
+    std::ostringstream y;
+    y << "source:\n  type: dataset\n  dataset:\n    path: " << dataset << "\n" << extra;
+    y << "output:\n  directory: " << dir_.path().string() << "\n";
+    y << "publish:\n  shm:\n    enabled: " << (shm.empty() ? "false" : "true") << "\n";
+    if (!shm.empty()) y << "    name: " << shm << "\n    ring_length: 4096\n";
+    if (udp_port_) y << "  udp:\n    destinations: [\"127.0.0.1:" << udp_port_ << "\"]\n";
+    return parseDaemonConfig(y.str(), dir_.file("daemon.yaml"));
+  }
+  test::TempDir dir_{"daemon"};
+  int udp_port_ = 0;
+};
+
+}  // namespace
+
+TEST_F(DaemonTest, EveryPoseGoesToSharedMemoryUdpAndTheTrajectoryIdentically) {
+  const std::string data = test::writeSmallDataset(dir_.file("data"), 3, 40);
+  const int rx = udpReceiver(udp_port_);
+  const std::string shm = "/mcslam-test-daemon-" + std::to_string(getpid());
+  const DaemonConfig c = config(data, "    rate: fastest\n    at_end: idle\n", shm);
+  std::vector<pose::PoseRecord> from_udp;
+  std::string trajectory;
+  std::vector<pose::PoseRecord> from_shm;
+  {
+    Daemon d(c, std::make_unique<FakeProcessor>());
+    pose::PoseShmReader reader;
+    ASSERT_TRUE(reader.open(shm));
+    d.start();
+    ASSERT_TRUE(waitFor([&] { return d.stats().published >= 40; }));
+    ASSERT_TRUE(d.stop());
+    for (uint64_t s = 1; s <= reader.published(); ++s) {
+      pose::PoseRecord r;
+      ASSERT_EQ(reader.readSequence(s, r), pose::ReadStatus::Ok);
+      from_shm.push_back(r);
+    }
+    const DaemonStats st = d.stats();
+    EXPECT_EQ(st.rig_drops, 0u);  // "fastest" is lossless
+    EXPECT_EQ(st.partial_frames, 0u);
+    trajectory = d.trajectoryPath();
+  }
+  from_udp = drainUdp(rx);
+  ::close(rx);
+  ASSERT_EQ(from_shm.size(), 40u);
+  ASSERT_EQ(from_udp.size(), 40u);
+  const auto rows = readTum(trajectory);
+  std::size_t row = 0, valid = 0;
+  for (std::size_t i = 0; i < 40; ++i) {
+    const pose::PoseRecord& s = from_shm[i];
+    const pose::PoseRecord& u = from_udp[i];
+    uint8_t a[pose::kPacketSize], b[pose::kPacketSize];
+    pose::encodePacket(s, a);
+    pose::encodePacket(u, b);
+    EXPECT_EQ(std::memcmp(a, b, sizeof(a)), 0) << "record " << i << " differs between shm and UDP";
+    EXPECT_EQ(s.sequence, i + 1);
+    EXPECT_EQ(s.frame_sequence, i);
+    EXPECT_EQ(s.capture_time_ns, 1000000000000ll + static_cast<int64_t>(i) * 50000000);
+    if (!s.valid()) continue;
+    ++valid;
+    ASSERT_LT(row, rows.size());
+    EXPECT_EQ(rows[row].first, tumTime(s.capture_time_ns));
+    ASSERT_EQ(rows[row].second.size(), 7u);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(rows[row].second[k], s.position[k]);
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(rows[row].second[3 + k], s.orientation[k]);
+    ++row;
+  }
+  EXPECT_GT(valid, 30u);
+  EXPECT_EQ(rows.size(), valid);  // nothing more, nothing less
+}
+
+TEST_F(DaemonTest, SlowProcessingDropsTheOldestRigFramesAndNeverStallsTheReplay) {
+  const std::string data = test::writeSmallDataset(dir_.file("data"), 2, 40, 32, 24, 5000000);  // 200 Hz
+  const DaemonConfig c = config(data, "    at_end: idle\ncapacities:\n  rig_ring_slots: 2\n");
+  Daemon d(c, std::make_unique<FakeProcessor>(20));  // 50 Hz at best
+  d.start();
+  ASSERT_TRUE(waitFor([&] { return d.stats().source_finished; }));
+  ASSERT_TRUE(waitFor([&] { return d.drained(); }));
+  ASSERT_TRUE(d.stop());
+  const DaemonStats s = d.stats();
+  EXPECT_EQ(s.camera_frames, 80u);  // the replay delivered every image on time: nothing waited for processing
+  EXPECT_EQ(s.rig_frames, 40u);
+  EXPECT_GT(s.rig_drops, 0u);
+  EXPECT_EQ(s.processed + s.rig_drops, s.rig_frames);
+  EXPECT_EQ(s.published, s.processed);
+}
+
+TEST_F(DaemonTest, TheNewestFrameSurvivesDropsAndPublishedFramesStayInOrder) {
+  const std::string data = test::writeSmallDataset(dir_.file("data"), 2, 30, 32, 24, 5000000);
+  const int rx = udpReceiver(udp_port_);
+  const DaemonConfig c = config(data, "    at_end: idle\n");
+  {
+    Daemon d(c, std::make_unique<FakeProcessor>(15));
+    d.start();
+    ASSERT_TRUE(waitFor([&] { return d.drained(); }));
+    d.stop();
+  }
+  const auto records = drainUdp(rx);
+  ::close(rx);
+  ASSERT_FALSE(records.empty());
+  for (std::size_t i = 1; i < records.size(); ++i) EXPECT_GT(records[i].frame_sequence, records[i - 1].frame_sequence);
+  EXPECT_EQ(records.back().frame_sequence, 29u);  // dropping takes the oldest, never the newest
+}
+
+TEST_F(DaemonTest, SoftwareTriggerDrivesTheReplayAndLatencyIsMeasured) {
+  const std::string data = test::writeSmallDataset(dir_.file("data"), 2, 10);
+  const DaemonConfig c = config(data, "    at_end: loop\ntrigger:\n  mode: software\n  rate_hz: 100\n");
+  Daemon d(c, std::make_unique<FakeProcessor>());
+  d.start();
+  ASSERT_TRUE(waitFor([&] { return d.stats().published >= 20; }));
+  d.stop();
+  const DaemonStats s = d.stats();
+  EXPECT_GE(s.triggers, 20u);
+  EXPECT_GE(s.latency_count, 20u);
+  EXPECT_GT(s.latency_p50_ns, 0);
+  EXPECT_LE(s.rig_frames, s.triggers);  // one frame per trigger at most
+}
+
+TEST_F(DaemonTest, NoDaemonThreadAllocatesPerFrameAfterWarmup) {
+  ASSERT_TRUE(alloc::available());
+  // 5 cameras, preloaded and looped, as fast as the pipeline takes them: thousands of frames quickly.
+  const std::string data = test::writeSmallDataset(dir_.file("data"), 5, 20, 64, 48);
+  const int rx = udpReceiver(udp_port_);
+  const std::string shm = "/mcslam-test-alloc-" + std::to_string(getpid());
+  const DaemonConfig c =
+      config(data, "    rate: fastest\n    at_end: loop\n    preload: true\nwarmup_frames: 100\n", shm);
+  Daemon d(c, createPipeline(c.slam, c.file, c.rig));  // the real pipeline (today's stub or the odometry)
+  d.start();
+  ASSERT_TRUE(waitFor([&] { return d.stats().processed >= 3000; }, 100));
+  d.stop();
+  ::close(rx);
+  const DaemonStats s = d.stats();
+  ASSERT_TRUE(s.warm);
+  EXPECT_GE(s.frames_after_warmup, 2800u);
+  EXPECT_EQ(s.allocations_after_warmup, 0u) << "over " << s.frames_after_warmup << " frames";
+}

@@ -1,0 +1,267 @@
+// mcslamd as a process, the way systemd runs it: READY=1 and WATCHDOG=1 arrive on a test NOTIFY_SOCKET,
+// another process (this test) reads the poses over shared memory and over UDP and they equal each other
+// and the trajectory file the daemon writes; SIGTERM ends it cleanly with the trajectory complete.
+// Also: no WATCHDOG=1 while no frame is processed, and a bad configuration ends start-up with one
+// message naming the key (exit status 2).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "daemon_fixture.hpp"
+#include "mcslam/pose_shm.hpp"
+#include "test_support.hpp"
+
+using namespace mcslam;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// Collects the datagrams sent to a NOTIFY_SOCKET.
+class NotifyListener {
+ public:
+  explicit NotifyListener(const std::string& path) : path_(path) {
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM, 0);
+    sockaddr_un a{};
+    a.sun_family = AF_UNIX;
+    std::snprintf(a.sun_path, sizeof(a.sun_path), "%s", path.c_str());
+    ok_ = ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0;
+    timeval tv{0, 100000};
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    thread_ = std::thread([this] {
+      char buf[1024];
+      while (!stop_) {
+        const ssize_t n = ::recv(fd_, buf, sizeof(buf), 0);
+        if (n <= 0) continue;
+        std::lock_guard<std::mutex> lock(m_);
+        messages_.emplace_back(buf, n);
+      }
+    });
+  }
+  ~NotifyListener() {
+    stop_ = true;
+    thread_.join();
+    ::close(fd_);
+  }
+  bool ok() const { return ok_; }
+  int count(const std::string& prefix) {
+    std::lock_guard<std::mutex> lock(m_);
+    int n = 0;
+    for (const auto& m : messages_) n += m.rfind(prefix, 0) == 0 ? 1 : 0;
+    return n;
+  }
+  std::string last(const std::string& prefix) {
+    std::lock_guard<std::mutex> lock(m_);
+    for (auto it = messages_.rbegin(); it != messages_.rend(); ++it)
+      if (it->rfind(prefix, 0) == 0) return *it;
+    return {};
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  bool ok_ = false;
+  std::atomic<bool> stop_{false};
+  std::mutex m_;
+  std::vector<std::string> messages_;
+  std::thread thread_;
+};
+
+pid_t spawnDaemon(const std::string& config, const std::string& notify, const std::string& watchdog_usec,
+                  const std::string& log) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::setenv("NOTIFY_SOCKET", notify.c_str(), 1);
+    ::setenv("WATCHDOG_USEC", watchdog_usec.c_str(), 1);
+    ::unsetenv("WATCHDOG_PID");
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    const std::string bin = test::binPath("mcslamd");
+    ::execl(bin.c_str(), bin.c_str(), "--config", config.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Waits (liveness bound only) for the child; returns its exit status, or -1.
+int waitExit(pid_t pid, int seconds) {
+  const auto deadline = Clock::now() + std::chrono::seconds(seconds);
+  int status = 0;
+  while (Clock::now() < deadline) {
+    if (::waitpid(pid, &status, WNOHANG) == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &status, 0);
+  return -1;
+}
+
+template <typename Pred>
+bool waitFor(Pred pred, int seconds = 60) {
+  const auto deadline = Clock::now() + std::chrono::seconds(seconds);
+  while (!pred()) {
+    if (Clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST(McslamdProcess, ReplayPublishesOverShmAndUdpEqualToTheTrajectoryAndStopsCleanlyOnSigterm) {
+  test::TempDir dir("mcslamd");
+  const int frames = 60;
+  const std::string data = test::writeSmallDataset(dir.file("data"), 3, frames);
+  NotifyListener notify(dir.file("notify.sock"));
+  ASSERT_TRUE(notify.ok());
+  const int rx = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(rx, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+  socklen_t len = sizeof(a);
+  ::getsockname(rx, reinterpret_cast<sockaddr*>(&a), &len);
+  timeval tv{0, 300000};
+  ::setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+
+  const std::string shm = "/mcslam-test-proc-" + std::to_string(getpid());
+  const std::string config = test::writeFile(dir.file("mcslamd.yaml"),
+      "log_level: debug\nstatus_interval_s: 0.2\n"
+      "source:\n  type: dataset\n  dataset:\n    path: data\n    rate: fastest\n    at_end: idle\n"
+      "publish:\n  shm:\n    name: " + shm + "\n    mode: \"0640\"\n    ring_length: 256\n"
+      "  udp:\n    destinations: [\"127.0.0.1:" + std::to_string(ntohs(a.sin_port)) + "\"]\n"
+      "output:\n  directory: out\n");
+  std::filesystem::create_directories(dir.file("out"));
+  const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "400000", dir.file("log.txt"));
+  ASSERT_GT(pid, 0);
+
+  ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));
+  pose::PoseShmReader reader;  // the segment exists before READY=1
+  std::string error;
+  ASSERT_TRUE(reader.open(shm, &error)) << error;
+  EXPECT_EQ(reader.writerPid(), pid);
+  ASSERT_TRUE(waitFor([&] { return reader.published() >= static_cast<uint64_t>(frames); }))
+      << readAll(dir.file("log.txt"));
+  std::vector<pose::PoseRecord> from_shm;
+  for (uint64_t s = 1; s <= reader.published(); ++s) {
+    pose::PoseRecord r;
+    ASSERT_EQ(reader.readSequence(s, r), pose::ReadStatus::Ok);
+    from_shm.push_back(r);
+  }
+  ASSERT_TRUE(waitFor([&] { return notify.count("WATCHDOG=1") >= 1 && notify.count("STATUS=") >= 1; }));
+  EXPECT_NE(notify.last("STATUS=").find("Hz"), std::string::npos) << notify.last("STATUS=");
+
+  const auto t0 = Clock::now();
+  ASSERT_EQ(::kill(pid, SIGTERM), 0);
+  const int status = waitExit(pid, 20);
+  const double stop_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  std::printf("mcslamd stopped %.3f s after SIGTERM\n", stop_s);  // reported, not asserted (no timing asserts)
+  const std::string log = readAll(dir.file("log.txt"));
+  EXPECT_EQ(status, 0) << log;
+  EXPECT_FALSE(reader.writerRunning());
+  EXPECT_EQ(notify.count("STOPPING=1"), 1);
+  EXPECT_NE(log.find("SIGTERM: stopping"), std::string::npos) << log;
+
+  std::vector<pose::PoseRecord> from_udp;
+  uint8_t buf[512];
+  for (;;) {
+    const ssize_t n = ::recv(rx, buf, sizeof(buf), 0);
+    if (n <= 0) break;
+    pose::PoseRecord r;
+    ASSERT_EQ(pose::decodePacket(buf, static_cast<std::size_t>(n), r), pose::DecodeStatus::Ok);
+    from_udp.push_back(r);
+  }
+  ::close(rx);
+
+  ASSERT_EQ(from_shm.size(), static_cast<std::size_t>(frames));
+  ASSERT_EQ(from_udp.size(), from_shm.size());
+  std::vector<std::string> expected_lines;
+  for (std::size_t i = 0; i < from_shm.size(); ++i) {
+    uint8_t x[pose::kPacketSize], y[pose::kPacketSize];
+    pose::encodePacket(from_shm[i], x);
+    pose::encodePacket(from_udp[i], y);
+    EXPECT_EQ(std::memcmp(x, y, sizeof(x)), 0) << "record " << i;
+    EXPECT_EQ(from_shm[i].sequence, i + 1);
+    EXPECT_EQ(from_shm[i].frame_sequence, i);  // fastest replay is lossless
+    if (!from_shm[i].valid()) continue;
+    std::ostringstream line;
+    const int64_t t = from_shm[i].capture_time_ns;
+    char stamp[32];
+    std::snprintf(stamp, sizeof(stamp), "%lld.%09lld", static_cast<long long>(t / 1000000000),
+                  static_cast<long long>(t % 1000000000));
+    expected_lines.push_back(stamp);
+  }
+  // The trajectory holds exactly the valid published poses (none with today's stub pipeline, all of
+  // them once the odometry initializes), complete after SIGTERM.
+  std::ifstream traj(dir.file("out/trajectory.tum"));
+  ASSERT_TRUE(traj.good());
+  std::vector<std::string> stamps;
+  std::string line;
+  while (std::getline(traj, line))
+    if (!line.empty() && line[0] != '#') stamps.push_back(line.substr(0, line.find(' ')));
+  EXPECT_EQ(stamps, expected_lines);
+}
+
+TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
+  test::TempDir dir("mcslamd-wd");
+  const std::string data = test::writeSmallDataset(dir.file("data"), 2, 5);
+  NotifyListener notify(dir.file("notify.sock"));
+  ASSERT_TRUE(notify.ok());
+  // Software trigger at 0.1 Hz: the first pulse (and so the first frame) is 10 s away.
+  const std::string config = test::writeFile(dir.file("mcslamd.yaml"),
+      "status_interval_s: 0.1\nsource:\n  type: dataset\n  dataset:\n    path: data\n"
+      "trigger:\n  mode: software\n  rate_hz: 0.1\n"
+      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
+  const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "100000", dir.file("log.txt"));
+  ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));
+  ASSERT_TRUE(waitFor([&] { return notify.count("STATUS=") >= 5; }));  // ticks happened (every 50 ms)
+  EXPECT_EQ(notify.count("WATCHDOG=1"), 0) << "watchdog kept alive without progress";
+  ::kill(pid, SIGINT);
+  EXPECT_EQ(waitExit(pid, 20), 0) << readAll(dir.file("log.txt"));
+}
+
+TEST(McslamdProcess, BadConfigEndsStartupWithOneMessageNamingTheKey) {
+  test::TempDir dir("mcslamd-bad");
+  test::writeSmallDataset(dir.file("data"), 2, 2);
+  const std::string config = test::writeFile(dir.file("bad.yaml"),
+      "source:\n  type: dataset\n  dataset:\n    path: data\ncapacities:\n  pose_ring_slots: 0\n");
+  std::string out;
+  const int rc = test::runCommand(test::binPath("mcslamd") + " --config " + config, &out);
+  EXPECT_EQ(rc, 2) << out;
+  EXPECT_NE(out.find("capacities.pose_ring_slots"), std::string::npos) << out;
+  EXPECT_NE(out.find(config), std::string::npos) << out;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << "one message:\n" << out;
+  const int check_rc = test::runCommand(test::binPath("mcslamd") + " --check-config " + config, &out);
+  EXPECT_EQ(check_rc, 2) << out;
+}
+
+TEST(McslamdProcess, CheckConfigPrintsTheEffectiveConfiguration) {
+  test::TempDir dir("mcslamd-check");
+  test::writeSmallDataset(dir.file("data"), 2, 2);
+  const std::string config =
+      test::writeFile(dir.file("ok.yaml"), "source:\n  type: dataset\n  dataset:\n    path: data\n");
+  std::string out;
+  ASSERT_EQ(test::runCommand(test::binPath("mcslamd") + " --check-config " + config, &out), 0) << out;
+  for (const char* key : {"rig_ring_slots: 2", "pose_ring_slots: 64", "name: /mcslam_pose", "mode: free_running",
+                          "slam:", "rig: 2 camera"})
+    EXPECT_NE(out.find(key), std::string::npos) << key << " missing in:\n" << out;
+}
