@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""Resident memory of mcslamd over a long run, and whether it stays flat.
+
+Runs mcslamd on a replay (a dataset folder you give, or a synthetic 5-camera ASL dataset made here with
+the standard library) until N poses were published, sampling VmRSS from /proc/<pid>/status and the
+publish count from the shared-memory header (docs/pose-protocol.md: u64 `published` at offset 48).
+Prints the samples and a summary: RSS after warm-up, at the end, the maximum, and the growth between.
+
+  tools/mcslamd/measure_rss.py --mcslamd build/bin/mcslamd [--dataset DIR] [--frames 10000]
+                               [--rate fastest|recorded] [--interval 1.0]
+"""
+import argparse
+import mmap
+import os
+import random
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+CALIB_5CAM = os.path.join(HERE, "..", "..", "tests", "data", "calib", "isec_5cam_camchain.yaml")
+
+
+def write_png(path, width, height, pixels):
+    """8-bit greyscale PNG (no filter), standard library only."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    raw = b"".join(b"\x00" + pixels[y * width:(y + 1) * width] for y in range(height))
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)) +
+                chunk(b"IDAT", zlib.compress(raw, 1)) + chunk(b"IEND", b""))
+
+
+def make_dataset(root, frames=20, width=720, height=540, cameras=5):
+    """An ASL folder: camchain.yaml (the 5-camera ISEC rig of tests/data), camN/data.csv, camN/data/<ns>.png."""
+    shutil.copy(CALIB_5CAM, os.path.join(root, "camchain.yaml"))
+    rng = random.Random(5)
+    for c in range(cameras):
+        os.makedirs(os.path.join(root, "cam%d" % c, "data"))
+        with open(os.path.join(root, "cam%d" % c, "data.csv"), "w") as csv:
+            csv.write("#timestamp [ns],filename\n")
+            for f in range(frames):
+                t = 1000000000000 + f * 50000000
+                # Blocky random texture: cheap to make, has corners for a feature detector.
+                blocks = bytes(rng.randrange(256) for _ in range((width // 8) * (height // 8)))
+                rows = []
+                for y in range(height):
+                    row = bytes(blocks[(y // 8) * (width // 8) + x // 8] for x in range(width))
+                    rows.append(row)
+                write_png(os.path.join(root, "cam%d" % c, "data", "%d.png" % t), width, height, b"".join(rows))
+                csv.write("%d,%d.png\n" % (t, t))
+
+
+def rss_kb(pid):
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    return 0
+
+
+def published(shm_name):
+    try:
+        with open("/dev/shm" + shm_name, "rb") as f:
+            with mmap.mmap(f.fileno(), 0, prot=mmap.PROT_READ) as m:
+                return struct.unpack_from("<Q", m, 48)[0]
+    except (OSError, ValueError):
+        return 0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--mcslamd", required=True)
+    ap.add_argument("--dataset", help="dataset folder (default: a synthetic 5-camera one)")
+    ap.add_argument("--frames", type=int, default=10000)
+    ap.add_argument("--rate", default="fastest", choices=["fastest", "recorded"])
+    ap.add_argument("--interval", type=float, default=1.0)
+    ap.add_argument("--warmup-frames", type=int, default=1000, help="frames before the 'after warm-up' sample")
+    ap.add_argument("--slam", default="{}", help="the slam: section (YAML flow text)")
+    args = ap.parse_args()
+
+    work = tempfile.mkdtemp(prefix="mcslamd-rss-")
+    try:
+        data = args.dataset
+        if not data:
+            data = os.path.join(work, "data")
+            os.makedirs(data)
+            print("making a synthetic 5-camera dataset in %s ..." % data, file=sys.stderr, flush=True)
+            make_dataset(data)
+        shm = "/mcslam-rss-%d" % os.getpid()
+        config = os.path.join(work, "mcslamd.yaml")
+        with open(config, "w") as f:
+            f.write("log_level: warn\nsource:\n  type: dataset\n  dataset:\n    path: %s\n    rate: %s\n"
+                    "    at_end: loop\npublish:\n  shm:\n    name: %s\noutput:\n  directory: %s\nslam: %s\n"
+                    % (data, args.rate, shm, work, args.slam))
+        proc = subprocess.Popen([args.mcslamd, "--config", config], stdout=subprocess.DEVNULL)
+        samples = []
+        start = time.time()
+        while True:
+            time.sleep(args.interval)
+            if proc.poll() is not None:
+                print("mcslamd exited early with status %d" % proc.returncode, file=sys.stderr)
+                return 1
+            n, kb = published(shm), rss_kb(proc.pid)
+            samples.append((time.time() - start, n, kb))
+            print("%8.1f s  %7d poses  VmRSS %8.1f MB" % (samples[-1][0], n, kb / 1024.0), flush=True)
+            if n >= args.frames:
+                break
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=30)
+        after = [s for s in samples if s[1] >= args.warmup_frames] or samples
+        first, last = after[0], samples[-1]
+        peak = max(s[2] for s in samples)
+        print("\nsummary: %d poses in %.0f s; VmRSS after %d poses %.1f MB, at the end %.1f MB, max %.1f MB, "
+              "growth after warm-up %+.1f MB; mcslamd exit status %d"
+              % (last[1], last[0], first[1], first[2] / 1024.0, last[2] / 1024.0, peak / 1024.0,
+                 (last[2] - first[2]) / 1024.0, proc.returncode))
+        return 0
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
