@@ -22,13 +22,12 @@ void downscale(const ConstPlane& src, const Plane& dst, float ratio, const Downs
     const uint8_t* a = src.row(y0);
     const uint8_t* b = src.row(std::min(y0 + 1, last_y));
     for (int x = 0; x < src.width; ++x) row[x] = static_cast<uint16_t>(a[x] * gy + b[x] * fy);  // vectorizes
+    row[src.width] = row[src.width - 1];  // a one-column source reads pair[1] here
     uint8_t* out = dst.row(y);
     for (int x = 0; x < dst.width; ++x) {
-      const int x0 = scratch.src_x[x];
+      const uint16_t* pair = row + scratch.src_x[x];  // src_x <= last_x - 1 (or 0 with one column)
       const uint32_t f = scratch.frac_x[x];
-      const uint32_t x1 = static_cast<uint32_t>(std::min(x0 + 1, last_x));
-      const uint32_t v = row[x0] * (256u - f) + row[x1] * f;
-      out[x] = static_cast<uint8_t>((v + (1u << 15)) >> 16);
+      out[x] = static_cast<uint8_t>((pair[0] * (256u - f) + pair[1] * f + (1u << 15)) >> 16);
     }
   }
 }

@@ -1,0 +1,268 @@
+// The ORB extractor's contract: FAST scores, SIMD = scalar, budgets, spread, sizes, orientation.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "mcslam/core/error.hpp"
+#include "mcslam/features/orb_extractor.hpp"
+#include "orb_fast.hpp"
+#include "orb_test_images.hpp"
+
+namespace mcslam {
+namespace {
+
+using test::texturedFrame;
+
+const Image& frame640() {
+  static const Image image = texturedFrame(640, 480, 21);
+  return image;
+}
+
+FeatureSet extractWith(const OrbOptions& options, const ImageView& view, int max_w = 640, int max_h = 480) {
+  OrbExtractor extractor(options, max_w, max_h);
+  FeatureSet out(options.max_features);
+  EXPECT_EQ(extractor.extract(view, out), OrbStatus::kOk);
+  return out;
+}
+
+void expectSame(const FeatureSet& a, const FeatureSet& b) {
+  ASSERT_EQ(a.count, b.count);
+  for (int i = 0; i < a.count; ++i) {
+    const Keypoint &p = a.keypoints[i], &q = b.keypoints[i];
+    ASSERT_EQ(p.x, q.x) << i;
+    ASSERT_EQ(p.y, q.y) << i;
+    ASSERT_EQ(p.angle, q.angle) << i;
+    ASSERT_EQ(p.response, q.response) << i;
+    ASSERT_EQ(p.octave, q.octave) << i;
+    ASSERT_EQ(a.descriptors[i], b.descriptors[i]) << i;
+  }
+}
+
+// FAST-9 score straight from its definition.
+int bruteForceFastScore(const Image& img, int x, int y) {
+  static const int cx[16] = {0, 1, 2, 3, 3, 3, 2, 1, 0, -1, -2, -3, -3, -3, -2, -1};
+  static const int cy[16] = {-3, -3, -2, -1, 0, 1, 2, 3, 3, 3, 2, 1, 0, -1, -2, -3};
+  const int c = img.data()[y * img.width() + x];
+  int best = 0;
+  for (int start = 0; start < 16; ++start) {
+    int bright = 255, dark = 255;
+    for (int k = 0; k < 9; ++k) {
+      const int p = img.data()[(y + cy[(start + k) % 16]) * img.width() + x + cx[(start + k) % 16]];
+      bright = std::min(bright, std::max(p - c, 0));
+      dark = std::min(dark, std::max(c - p, 0));
+    }
+    best = std::max({best, bright, dark});
+  }
+  return best;
+}
+
+TEST(OrbFast, ScoresMatchTheDefinitionOnBothKernels) {
+  const Image& img = frame640();
+  std::vector<uint8_t> row(img.width() + 16);
+  int corners_seen = 0;
+  for (int threshold : {7, 20, 40}) {
+    for (int y = 3; y < 200; ++y) {
+      for (auto backend : {orb_detail::FastBackend::kScalar, orb_detail::FastBackend::kNative}) {
+        // An odd segment end exercises the partial last group.
+        const int x0 = 3, x1 = img.width() - 3 - (y % 7);
+        const int n = orb_detail::fastScoreRow(img.data(), img.width(), y, x0, x1, threshold, row.data(), backend);
+        int counted = 0;
+        for (int x = x0; x < x1; ++x) {
+          const int expected = bruteForceFastScore(img, x, y);
+          ASSERT_EQ(row[x - x0], expected > threshold ? expected : 0) << "x " << x << " y " << y << " t " << threshold;
+          counted += row[x - x0] != 0;
+        }
+        EXPECT_EQ(n, counted);
+        corners_seen += counted;
+      }
+    }
+  }
+  EXPECT_GT(corners_seen, 1000);  // the frame has corners at all three thresholds
+}
+
+TEST(OrbExtractor, SimdAndScalarKernelsGiveIdenticalFeatures) {
+  OrbOptions simd, scalar;
+  scalar.use_simd = false;
+  const FeatureSet a = extractWith(simd, frame640().view());
+  const FeatureSet b = extractWith(scalar, frame640().view());
+  EXPECT_EQ(a.count, simd.max_features);
+  expectSame(a, b);
+}
+
+TEST(OrbExtractor, FillsTheBudgetInsideTheImageAndSpreadsIt) {
+  OrbOptions options;
+  const FeatureSet f = extractWith(options, frame640().view());
+  ASSERT_EQ(f.count, options.max_features);
+  const auto scales = orbLevelScales(options);
+  int per_level[8] = {};
+  int blocks[6][8] = {};  // 80x80 blocks
+  for (int i = 0; i < f.count; ++i) {
+    const Keypoint& k = f.keypoints[i];
+    ASSERT_GE(k.octave, 0);
+    ASSERT_LT(k.octave, options.levels);
+    const float margin = options.edge_margin * scales.scale[k.octave] - 1.0f;
+    EXPECT_GE(k.x, margin);
+    EXPECT_GE(k.y, margin);
+    EXPECT_LE(k.x, 639 - margin);
+    EXPECT_LE(k.y, 479 - margin);
+    EXPECT_GE(k.angle, 0.0f);
+    EXPECT_LT(k.angle, 2 * std::numbers::pi_v<float>);
+    EXPECT_GT(k.response, 0.0f);
+    ++per_level[k.octave];
+    ++blocks[std::min(5, static_cast<int>(k.y / 80))][std::min(7, static_cast<int>(k.x / 80))];
+  }
+  // Every level contributes, finer levels more (ORB's geometric split).
+  for (int l = 0; l < options.levels; ++l) EXPECT_GT(per_level[l], 0) << l;
+  EXPECT_GT(per_level[0], per_level[options.levels - 1]);
+  // Spread: against the strongest-only choice, more 80x80 blocks hold features and the fullest holds
+  // fewer; nearly all blocks are used (the frame has a few flat, saturated patches).
+  OrbOptions strongest = options;
+  strongest.spacing_ratio = 0;
+  const FeatureSet g = extractWith(strongest, frame640().view());
+  int strongest_blocks[6][8] = {};
+  for (int i = 0; i < g.count; ++i)
+    ++strongest_blocks[std::min(5, static_cast<int>(g.keypoints[i].y / 80))][std::min(7, static_cast<int>(g.keypoints[i].x / 80))];
+  auto occupied = [](const int (&b)[6][8]) { int n = 0; for (auto& r : b) for (int v : r) n += v > 0; return n; };
+  auto fullest = [](const int (&b)[6][8]) { int n = 0; for (auto& r : b) for (int v : r) n = std::max(n, v); return n; };
+  EXPECT_GE(occupied(blocks), 44);
+  EXPECT_GE(occupied(blocks), occupied(strongest_blocks));
+  EXPECT_LT(fullest(blocks), fullest(strongest_blocks));
+  // No two features of a level at the same pixel.
+  for (int i = 0; i < f.count; ++i) {
+    for (int j = i + 1; j < f.count; ++j) {
+      const Keypoint &p = f.keypoints[i], &q = f.keypoints[j];
+      ASSERT_FALSE(p.octave == q.octave && p.x == q.x && p.y == q.y);
+    }
+  }
+}
+
+TEST(OrbExtractor, LowThresholdFallbackFindsFeaturesInWeakTexture) {
+  // A faint texture: few corners pass threshold 20, many pass 7.
+  Image faint(320, 240);
+  const Image source = texturedFrame(320, 240, 5);
+  for (int i = 0; i < 320 * 240; ++i) faint.data()[i] = static_cast<uint8_t>(100 + source.data()[i] / 4);
+  OrbOptions with_fallback, without;
+  with_fallback.max_features = without.max_features = 500;
+  without.min_fast_threshold = without.fast_threshold;
+  const FeatureSet a = extractWith(with_fallback, faint.view(), 320, 240);
+  const FeatureSet b = extractWith(without, faint.view(), 320, 240);
+  EXPECT_GT(a.count, b.count + 100) << a.count << " vs " << b.count;
+}
+
+TEST(OrbExtractor, EmptyTinyAndOversizedImages) {
+  OrbExtractor extractor(OrbOptions{}, 640, 480);
+  FeatureSet out(1000);
+  out.count = 5;
+  EXPECT_EQ(extractor.extract(ImageView{}, out), OrbStatus::kOk);
+  EXPECT_EQ(out.count, 0);
+  for (int size : {1, 2, 10, 31, 32, 33}) {
+    Image tiny(size, size);
+    std::fill(tiny.data(), tiny.data() + size * size, uint8_t{77});
+    for (int i = 0; i < size * size; i += 3) tiny.data()[i] = 200;
+    EXPECT_EQ(extractor.extract(tiny.view(), out), OrbStatus::kOk) << size;
+    EXPECT_EQ(out.count, 0) << size;
+  }
+  Image wide(641, 100);
+  EXPECT_EQ(extractor.extract(wide.view(), out), OrbStatus::kImageTooLarge);
+  EXPECT_EQ(out.count, 0);
+  FeatureSet small(999);
+  EXPECT_EQ(extractor.extract(frame640().view(), small), OrbStatus::kOutputTooSmall);
+  EXPECT_EQ(small.count, 0);
+  // A flat image has no corner anywhere.
+  Image flat(640, 480);
+  std::fill(flat.data(), flat.data() + 640 * 480, uint8_t{90});
+  EXPECT_EQ(extractor.extract(flat.view(), out), OrbStatus::kOk);
+  EXPECT_EQ(out.count, 0);
+}
+
+TEST(OrbExtractor, SmallerImagesAndStridedViewsWork) {
+  // A 300x200 window of the frame, seen through the frame's stride, equals the same pixels copied.
+  const Image& big = frame640();
+  const ImageView window{big.data() + 50 * big.width() + 70, 300, 200, big.width()};
+  Image copy(300, 200);
+  for (int y = 0; y < 200; ++y) std::copy(window.row(y), window.row(y) + 300, copy.row(y));
+  OrbOptions options;
+  options.max_features = 300;
+  const FeatureSet a = extractWith(options, window);
+  const FeatureSet b = extractWith(options, copy.view());
+  EXPECT_GT(a.count, 200);
+  expectSame(a, b);
+  // And the same extractor reused for the full frame afterwards gives the fresh-extractor answer.
+  OrbExtractor reused(options, 640, 480);
+  FeatureSet c(300), d(300);
+  reused.extract(window, c);
+  reused.extract(big.view(), c);
+  OrbExtractor fresh(options, 640, 480);
+  fresh.extract(big.view(), d);
+  expectSame(c, d);
+}
+
+TEST(OrbExtractor, RotatingTheImageBy90DegreesRotatesAnglesAndKeepsDescriptors) {
+  // Exact 90-degree rotation (no resampling at level 0): FAST, the centroid and the smoothing are
+  // symmetric under it, so each level-0 keypoint reappears with its angle + 90 degrees and, the
+  // pattern being steered, nearly the same descriptor.
+  const Image& src = frame640();
+  const int w = src.width(), h = src.height();
+  Image rotated(h, w);  // (x, y) -> (h - 1 - y, x): clockwise on screen, +90 degrees with y down
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) rotated.row(x)[h - 1 - y] = src.data()[y * w + x];
+  OrbOptions options;
+  options.levels = 1;
+  options.max_features = 300;
+  options.spacing_ratio = 0;  // strongest first: the same corners in both images
+  const FeatureSet a = extractWith(options, src.view(), 640, 640);
+  const FeatureSet b = extractWith(options, rotated.view(), 640, 640);
+  int found = 0, close_descriptors = 0;
+  for (int i = 0; i < a.count; ++i) {
+    const float rx = h - 1 - a.keypoints[i].y, ry = a.keypoints[i].x;
+    for (int j = 0; j < b.count; ++j) {
+      if (b.keypoints[j].x != rx || b.keypoints[j].y != ry) continue;
+      ++found;
+      float turn = b.keypoints[j].angle - a.keypoints[i].angle;
+      if (turn < 0) turn += 2 * std::numbers::pi_v<float>;
+      EXPECT_NEAR(turn, std::numbers::pi_v<float> / 2, 1e-3);
+      close_descriptors += hammingDistance(a.descriptors[i], b.descriptors[j]) <= 16;
+    }
+  }
+  EXPECT_GT(found, 250);  // ties at the budget's edge may differ
+  EXPECT_GT(close_descriptors, 0.9 * found);
+}
+
+TEST(OrbExtractor, IsDeterministicAcrossRunsAndInstances) {
+  OrbOptions options;
+  OrbExtractor one(options, 640, 480), two(options, 640, 480);
+  FeatureSet a(1000), b(1000), c(1000);
+  one.extract(frame640().view(), a);
+  one.extract(frame640().view(), b);
+  two.extract(frame640().view(), c);
+  expectSame(a, b);
+  expectSame(a, c);
+}
+
+TEST(OrbExtractor, LevelScalesAndOptionChecks) {
+  OrbOptions options;
+  const OrbLevelScales s = orbLevelScales(options);
+  ASSERT_EQ(s.scale.size(), 8u);
+  for (int l = 0; l < 8; ++l) {
+    EXPECT_NEAR(s.scale[l], std::pow(1.2, l), 1e-5);
+    EXPECT_NEAR(s.sigma2[l], std::pow(1.44, l), 1e-4);
+    EXPECT_NEAR(s.inv_scale[l] * s.scale[l], 1.0f, 1e-6);
+    EXPECT_NEAR(s.inv_sigma2[l] * s.sigma2[l], 1.0f, 1e-6);
+  }
+  EXPECT_EQ(OrbExtractor(options, 10, 10).levelScales().scale, s.scale);
+  auto bad = [](auto change) {
+    OrbOptions o;
+    change(o);
+    EXPECT_THROW(OrbExtractor(o, 100, 100), InputError);
+  };
+  bad([](OrbOptions& o) { o.levels = 0; });
+  bad([](OrbOptions& o) { o.scale_factor = 1.0f; });
+  bad([](OrbOptions& o) { o.max_features = 0; });
+  bad([](OrbOptions& o) { o.edge_margin = 10; });
+  bad([](OrbOptions& o) { o.min_fast_threshold = 30; });
+}
+
+}  // namespace
+}  // namespace mcslam

@@ -1,0 +1,125 @@
+// FeatureWorkers: same features as one extractor per camera, whatever the thread count; absent
+// cameras; no allocation per rig frame; clean start and stop.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/core/error.hpp"
+#include "mcslam/features/feature_workers.hpp"
+#include "orb_test_images.hpp"
+
+namespace mcslam {
+namespace {
+
+constexpr int kCameras = 5;
+
+struct Rig {
+  std::vector<Image> images;
+  std::vector<ImageView> views;
+  std::vector<ImageSize> sizes;
+  Rig() {
+    for (int c = 0; c < kCameras; ++c) {
+      // Different sizes per camera: each extractor is sized for its own camera.
+      images.push_back(test::texturedFrame(320 - 16 * c, 240 - 8 * c, 100 + c));
+      sizes.push_back({images.back().width(), images.back().height()});
+    }
+    for (const Image& image : images) views.push_back(image.view());
+  }
+};
+
+const Rig& rig() {
+  static const Rig r;
+  return r;
+}
+
+OrbOptions options() {
+  OrbOptions o;
+  o.max_features = 400;
+  return o;
+}
+
+std::vector<FeatureSet> makeSets() { return std::vector<FeatureSet>(kCameras, FeatureSet(options().max_features)); }
+
+void expectSame(const FeatureSet& a, const FeatureSet& b) {
+  ASSERT_EQ(a.count, b.count);
+  for (int i = 0; i < a.count; ++i) {
+    ASSERT_EQ(a.keypoints[i].x, b.keypoints[i].x);
+    ASSERT_EQ(a.keypoints[i].y, b.keypoints[i].y);
+    ASSERT_EQ(a.keypoints[i].angle, b.keypoints[i].angle);
+    ASSERT_EQ(a.keypoints[i].octave, b.keypoints[i].octave);
+    ASSERT_EQ(a.descriptors[i], b.descriptors[i]);
+  }
+}
+
+TEST(FeatureWorkers, SameFeaturesAsSequentialExtractionForAnyThreadCount) {
+  std::vector<FeatureSet> expected = makeSets();
+  for (int c = 0; c < kCameras; ++c) {
+    OrbExtractor extractor(options(), rig().sizes[c].width, rig().sizes[c].height);
+    ASSERT_EQ(extractor.extract(rig().views[c], expected[c]), OrbStatus::kOk);
+    ASSERT_GT(expected[c].count, 300);
+  }
+  const bool present[kCameras] = {true, true, true, true, true};
+  for (int threads : {1, 2, 3, 5, 8}) {
+    FeatureWorkers workers(options(), rig().sizes, threads);
+    EXPECT_EQ(workers.threads(), std::min(threads, kCameras));
+    std::vector<FeatureSet> out = makeSets();
+    for (int frame = 0; frame < 3; ++frame) {  // the same frame again gives the same answer
+      OrbStatus status[kCameras];
+      workers.extract(rig().views.data(), present, out.data(), status);
+      for (int c = 0; c < kCameras; ++c) {
+        EXPECT_EQ(status[c], OrbStatus::kOk);
+        expectSame(out[c], expected[c]);
+      }
+    }
+  }
+}
+
+TEST(FeatureWorkers, DefaultPoolIsOneThreadPerCameraUpToTheCores) {
+  FeatureWorkers workers(options(), rig().sizes);
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  EXPECT_EQ(workers.threads(), std::min(kCameras, cores));
+  EXPECT_EQ(workers.cameras(), kCameras);
+  EXPECT_THROW(FeatureWorkers(options(), {}), InputError);
+}
+
+TEST(FeatureWorkers, AbsentCamerasGetNoFeatures) {
+  FeatureWorkers workers(options(), rig().sizes, 2);
+  std::vector<FeatureSet> out = makeSets();
+  for (FeatureSet& set : out) set.count = 7;  // stale values must be cleared
+  const bool present[kCameras] = {true, false, true, false, false};
+  workers.extract(rig().views.data(), present, out.data());
+  EXPECT_GT(out[0].count, 0);
+  EXPECT_EQ(out[1].count, 0);
+  EXPECT_GT(out[2].count, 0);
+  EXPECT_EQ(out[3].count, 0);
+  EXPECT_EQ(out[4].count, 0);
+}
+
+TEST(FeatureWorkers, RigFramesAllocateNothingOnAnyThread) {
+  ASSERT_TRUE(alloc::available());
+  FeatureWorkers workers(options(), rig().sizes, 2);
+  std::vector<FeatureSet> out = makeSets();
+  const bool present[kCameras] = {true, true, false, true, true};
+  workers.extract(rig().views.data(), present, out.data());  // warm-up
+  const uint64_t before = alloc::totalCount();  // all threads of the process
+  for (int frame = 0; frame < 5; ++frame) workers.extract(rig().views.data(), present, out.data());
+  EXPECT_EQ(alloc::totalCount() - before, 0u);
+  EXPECT_GT(out[4].count, 0);
+}
+
+TEST(FeatureWorkers, StartsAndStopsCleanly) {
+  // Destroyed right after construction, after one frame, and with more threads than cameras asked.
+  for (int round = 0; round < 20; ++round) {
+    FeatureWorkers workers(options(), rig().sizes, 1 + round % 6);
+    if (round % 2 == 0) {
+      std::vector<FeatureSet> out = makeSets();
+      const bool present[kCameras] = {true, true, true, true, true};
+      workers.extract(rig().views.data(), present, out.data());
+      EXPECT_GT(out[0].count, 0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mcslam
