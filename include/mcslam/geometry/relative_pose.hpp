@@ -1,0 +1,87 @@
+#pragma once
+// Relative pose between two rig frames, for map initialization (paper IV-B, eq. 4).
+//
+// THIS RUNS RARELY AND ALLOCATES: it uses OpenGV's adapters, sample-consensus problems and
+// minimal solvers (std::vector everywhere). Never call it on the per-frame path.
+//
+//  - Generalized (a rig of cameras with distinct centres): the 17-point linear solver (Li, Hartley,
+//    Kim 2008, OpenGV's seventeenpt) in RANSAC; the translation is METRIC.
+//  - Central (one camera): the 5-point solver (Nister, OpenGV's fivept_nister) in RANSAC; the
+//    translation has UNIT NORM (its scale is not observable) and the pose is that of the camera.
+// Both are then refined by Levenberg-Marquardt on the generalized epipolar error (eq. 4) divided
+// by its first-order standard deviation (a Sampson error, in radians), Huber loss, and inliers
+// are re-selected (including: the point triangulates in front of both cameras).
+//
+// Degenerate motion is reported instead of a wrong initialization: the information matrix of the
+// refined pose, with the bearing noise given in the options, yields the standard deviation of the
+// metric scale (generalized: zero rotation with a non-overlapping rig leaves it unobservable) and
+// of the translation direction (central: too little parallax leaves it unobservable). The caller
+// then waits for better frames.
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mcslam/calib/rig.hpp"
+
+namespace mcslam {
+
+// A feature matched between frame 1 and frame 2 (possibly seen by different cameras of the rig).
+struct RelativeCorrespondence {
+  int camera1 = 0;
+  Vec3 bearing1 = Vec3::UnitZ();  // unit bearing in camera1's frame, frame 1
+  int camera2 = 0;
+  Vec3 bearing2 = Vec3::UnitZ();  // unit bearing in camera2's frame, frame 2
+};
+
+struct RelativePoseOptions {
+  // Standard deviation of a bearing (about pixel sigma / focal length; 1 px at f = 500 here). It sets
+  // the inlier threshold and the noise of the observability check.
+  double bearing_sigma_rad = 0.002;
+  double inlier_sigmas = 3.0;        // inlier when the (Sampson) angle error is below this many sigmas
+  int max_iterations = 2000;         // RANSAC samples cap (17 points per sample in the generalized case)
+  double confidence = 0.99;
+  uint64_t seed = 1;                 // RANSAC sampler seed (deterministic)
+  int min_inliers = 30;
+  double max_relative_scale_sigma = 0.03;  // generalized: sigma(|t|) / |t| above this -> ScaleUnobservable
+  double max_direction_sigma_rad = 0.05;   // sigma of the translation direction above this -> DirectionUnobservable
+  double min_median_parallax_rad = 0.017;  // median rotation-compensated ray angle below this -> LowParallax (1 deg)
+};
+
+enum class RelativePoseStatus : uint8_t {
+  Ok = 0,
+  TooFewCorrespondences,
+  NoConsensus,            // RANSAC found no model with min_inliers
+  ScaleUnobservable,      // generalized only: metric scale not determined (e.g. no rotation, no overlap)
+  DirectionUnobservable,  // translation direction not determined (e.g. pure rotation)
+  LowParallax,            // observable, but the rays are too close to parallel to triangulate well
+};
+
+const char* relativePoseStatusName(RelativePoseStatus s);
+
+struct RelativePoseResult {
+  RelativePoseStatus status = RelativePoseStatus::TooFewCorrespondences;
+  // Frame 2 -> frame 1 (p_1 = T_1_2 * p_2). Generalized: body frames, metric translation.
+  // Central: camera frames, |t| = 1.
+  SE3 T_1_2;
+  bool metric = false;
+  std::vector<uint8_t> inlier_mask;  // one per correspondence
+  int num_inliers = 0;
+  int ransac_iterations = 0;
+  double relative_scale_sigma = INFINITY;  // sigma(|t|) / |t| (generalized), infinite for central
+  double direction_sigma_rad = INFINITY;   // largest sigma of the translation direction
+  double median_parallax_rad = 0;          // median angle between matched rays once the rotation is removed
+  bool ok() const { return status == RelativePoseStatus::Ok; }
+};
+
+// Generalized relative pose of the rig between two frames (metric). A rig of one camera has no
+// metric scale: ScaleUnobservable (use estimateCentralRelativePose).
+RelativePoseResult estimateGeneralizedRelativePose(const Rig& rig, std::span<const RelativeCorrespondence> matches,
+                                                   const RelativePoseOptions& options = {});
+
+// Central relative pose of one camera between two frames (camera indices are ignored; bearings
+// in the camera frame). Unit translation.
+RelativePoseResult estimateCentralRelativePose(std::span<const RelativeCorrespondence> matches,
+                                               const RelativePoseOptions& options = {});
+
+}  // namespace mcslam

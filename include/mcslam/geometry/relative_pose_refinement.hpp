@@ -1,0 +1,44 @@
+#pragma once
+// The parts of the relative pose that are ours (relative_pose.cpp uses them; public for the tests):
+// refinement, inlier selection and observability on matched rays, with the generalized epipolar
+// constraint (paper eq. 4). Allocates (initialization only).
+#include <span>
+#include <vector>
+
+#include "mcslam/geometry/relative_pose.hpp"
+
+namespace mcslam::relative_pose_detail {
+
+// A match as two rays, each in its own frame (body frames, or camera frames in the central case):
+// camera centre c and unit direction d.
+struct RayPair {
+  Vec3 c1, d1, c2, d2;
+};
+
+// Generalized epipolar error of a match under T_1_2 = (R, t), divided by its first-order standard
+// deviation per unit bearing noise (a Sampson error, radians). With J: its derivative with respect
+// to [dt; phi] for t + dt, R * exp(phi) (the normalization held fixed).
+double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J = nullptr);
+
+// Levenberg-Marquardt with Huber loss over the matches with mask != 0. fixed_scale: |t| keeps its
+// starting value (central poses, and the first stage of generalized ones: where the scale is weak
+// a free |t| can slide toward the trivial solution t = 0, R = I that every locally central match
+// satisfies).
+SE3 refineRelativePose(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& T_1_2,
+                       bool fixed_scale, const RelativePoseOptions& options);
+
+// Marks the matches within the angle threshold whose point triangulates in front of both cameras.
+int selectInliers(std::span<const RayPair> matches, const SE3& T_1_2, double max_angle_rad, std::vector<uint8_t>& mask);
+
+struct Observability {
+  double relative_scale_sigma = INFINITY;
+  double direction_sigma_rad = INFINITY;
+  double median_parallax_rad = 0;
+};
+
+// Uncertainty of the translation (metric scale and direction) from the information matrix of the
+// inliers at T_1_2, with bearing noise sigma; and the median rotation-compensated parallax.
+Observability analyzeObservability(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& T_1_2,
+                                   bool central, double bearing_sigma_rad);
+
+}  // namespace mcslam::relative_pose_detail

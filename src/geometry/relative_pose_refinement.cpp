@@ -1,0 +1,258 @@
+#include "mcslam/geometry/relative_pose_refinement.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+
+namespace mcslam::relative_pose_detail {
+
+namespace {
+
+using Row6 = Eigen::Matrix<double, 1, 6>;
+
+// Two unit vectors orthogonal to t (columns): the tangent of the unit sphere at t.
+Eigen::Matrix<double, 3, 2> tangentBasis(const Vec3& t) {
+  const Vec3 n = t.normalized();
+  const Vec3 a = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  Eigen::Matrix<double, 3, 2> B;
+  B.col(0) = n.cross(a).normalized();
+  B.col(1) = n.cross(B.col(0));
+  return B;
+}
+
+double huberLoss(double s, double k) { return s <= k * k ? s : 2.0 * k * std::sqrt(s) - k * k; }
+double huberWeight(double s, double k) { return s <= k * k ? 1.0 : k / std::sqrt(s); }
+
+double cost(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& T, double k) {
+  double c = 0;
+  for (size_t i = 0; i < matches.size(); ++i) {
+    if (!mask[i]) continue;
+    const double e = sampsonError(matches[i], T);
+    c += huberLoss(e * e, k);
+  }
+  return c;
+}
+
+// Parameters of the solved pose: with a fixed scale, t moves on its sphere (2 parameters).
+SE3 applyStep(const SE3& T, const Eigen::VectorXd& step, bool fixed_scale, const Eigen::Matrix<double, 3, 2>& B) {
+  SE3 out = T;
+  if (fixed_scale) {
+    out.t = (T.t + B * step.head<2>()).normalized() * T.t.norm();
+    out.R = T.R * so3Exp(step.tail<3>());
+  } else {
+    out.t = T.t + step.head<3>();
+    out.R = T.R * so3Exp(step.tail<3>());
+  }
+  return out;
+}
+
+// Derivative of the normalized error including its normalization (central differences): away
+// from the optimum the frozen-normalization Jacobian is not a descent direction and LM stalls.
+double fullJacobian(const RayPair& m, const SE3& T, Row6& J) {
+  constexpr double h = 1e-7;
+  for (int k = 0; k < 6; ++k) {
+    SE3 Tp = T, Tm = T;
+    if (k < 3) {
+      Tp.t[k] += h;
+      Tm.t[k] -= h;
+    } else {
+      Tp.R = T.R * so3Exp(Vec3::Unit(k - 3) * h);
+      Tm.R = T.R * so3Exp(-Vec3::Unit(k - 3) * h);
+    }
+    J(k) = (sampsonError(m, Tp) - sampsonError(m, Tm)) / (2 * h);
+  }
+  return sampsonError(m, T);
+}
+
+// The match with its bearings moved (first order, to convergence) onto the model T: the Jacobian
+// for the information matrix must not contain the measurement noise, or the noise itself looks
+// like information about weakly observed directions (the metric scale above all).
+RayPair consistentRays(const RayPair& m, const SE3& T) {
+  RayPair c = m;
+  for (int it = 0; it < 5; ++it) {
+    const Vec3 t = T.t;
+    const Mat3& R = T.R;
+    const Vec3 m1 = c.c1.cross(c.d1);
+    const Vec3 Rd2 = R * c.d2;
+    const Vec3 Rm2 = R * c.c2.cross(c.d2);
+    const double e = c.d1.dot(t.cross(Rd2) + Rm2) + m1.dot(Rd2);
+    Vec3 g1 = Rm2 + t.cross(Rd2) + Rd2.cross(c.c1);
+    Vec3 g2 = (R.transpose() * c.d1).cross(c.c2) + R.transpose() * (c.d1.cross(t)) + R.transpose() * m1;
+    g1 -= g1.dot(c.d1) * c.d1;
+    g2 -= g2.dot(c.d2) * c.d2;
+    const double s2 = g1.squaredNorm() + g2.squaredNorm();
+    if (!(s2 > 1e-24)) break;
+    c.d1 = (c.d1 - (e / s2) * g1).normalized();
+    c.d2 = (c.d2 - (e / s2) * g2).normalized();
+    if (std::abs(e) < 1e-15) break;
+  }
+  return c;
+}
+
+}  // namespace
+
+double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J) {
+  const Mat3& R = T_1_2.R;
+  const Vec3& t = T_1_2.t;
+  const Vec3 m1 = m.c1.cross(m.d1);
+  const Vec3 m2 = m.c2.cross(m.d2);
+  const Vec3 Rd2 = R * m.d2;
+  const Vec3 Rm2 = R * m2;
+  // Line 2 in frame 1 has direction R d2 and moment R m2 + t x R d2; lines meet when d1.m2' + d2'.m1 = 0.
+  const double e = m.d1.dot(t.cross(Rd2) + Rm2) + m1.dot(Rd2);
+  // Derivatives of e with respect to each bearing (the moments move with them), projected on the
+  // plane where bearing noise lives.
+  const Vec3 g1 = Rm2 + t.cross(Rd2) + Rd2.cross(m.c1);
+  const Vec3 Rt_d1 = R.transpose() * m.d1;
+  const Vec3 g2 = Rt_d1.cross(m.c2) + R.transpose() * (m.d1.cross(t)) + R.transpose() * m1;
+  const double s2 = (g1 - g1.dot(m.d1) * m.d1).squaredNorm() + (g2 - g2.dot(m.d2) * m.d2).squaredNorm();
+  const double s = std::sqrt(std::max(s2, 1e-24));
+  if (J) {
+    J->leftCols<3>() = Rd2.cross(m.d1).transpose() / s;
+    const Vec3 dphi = (R.transpose() * m.d1.cross(t)).cross(m.d2) + Rt_d1.cross(m2) + (R.transpose() * m1).cross(m.d2);
+    J->rightCols<3>() = -dphi.transpose() / s;
+  }
+  return e / s;
+}
+
+SE3 refineRelativePose(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& start,
+                       bool fixed_scale, const RelativePoseOptions& options) {
+  const bool central = fixed_scale;  // same parametrization
+  const int dim = central ? 5 : 6;
+  const double k = 2.0 * options.bearing_sigma_rad;
+  SE3 T = start;
+  if (!(T.t.norm() > 0)) return T;
+  double c = cost(matches, mask, T, k);
+  double lambda = 1e-4;
+  for (int it = 0; it < 100; ++it) {
+    const Eigen::Matrix<double, 3, 2> B = tangentBasis(T.t);
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(dim);
+    for (size_t i = 0; i < matches.size(); ++i) {
+      if (!mask[i]) continue;
+      Row6 J6;
+      const double e = fullJacobian(matches[i], T, J6);
+      Eigen::RowVectorXd J(dim);
+      if (central) {
+        J << J6.leftCols<3>() * B, J6.rightCols<3>();
+      } else {
+        J = J6;
+      }
+      const double w = huberWeight(e * e, k);
+      H.noalias() += w * J.transpose() * J;
+      g.noalias() += w * J.transpose() * e;
+    }
+    bool improved = false;
+    Eigen::VectorXd step;
+    while (lambda < 1e10) {
+      Eigen::MatrixXd A = H;
+      A.diagonal() += lambda * (H.diagonal().array() + 1e-12).matrix();
+      step = A.ldlt().solve(-g);
+      if (!step.allFinite()) break;
+      const SE3 candidate = applyStep(T, step, central, B);
+      const double cc = cost(matches, mask, candidate, k);
+      if (cc < c) {
+        T = candidate;
+        c = cc;
+        lambda = std::max(lambda * 0.2, 1e-9);
+        improved = true;
+        break;
+      }
+      lambda *= 10;
+    }
+    if (!improved || step.norm() < 1e-12) break;
+  }
+  T.normalize();
+  return T;
+}
+
+int selectInliers(std::span<const RayPair> matches, const SE3& T, double max_angle_rad, std::vector<uint8_t>& mask) {
+  mask.assign(matches.size(), 0);
+  int count = 0;
+  for (size_t i = 0; i < matches.size(); ++i) {
+    const RayPair& m = matches[i];
+    if (!(std::abs(sampsonError(m, T)) < max_angle_rad)) continue;
+    // Midpoint triangulation in frame 1: both depths must be positive, unless the rays are too
+    // close to parallel for the sign to mean anything.
+    const Vec3 d2 = T.R * m.d2;
+    const Vec3 w = T.R * m.c2 + T.t - m.c1;
+    const double b = m.d1.dot(d2);
+    if (1.0 - b * b > 4.0 * max_angle_rad * max_angle_rad) {
+      const double l2 = (d2.dot(w) - b * m.d1.dot(w)) / (b * b - 1.0);
+      const double l1 = m.d1.dot(w) + b * l2;
+      if (!(l1 > 0 && l2 > 0)) continue;
+    }
+    mask[i] = 1;
+    ++count;
+  }
+  return count;
+}
+
+Observability analyzeObservability(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& T,
+                                   bool central, double bearing_sigma_rad) {
+  Observability out;
+  Mat6 H = Mat6::Zero();
+  std::vector<double> parallax;
+  const double inv_var = 1.0 / (bearing_sigma_rad * bearing_sigma_rad);
+  for (size_t i = 0; i < matches.size(); ++i) {
+    if (!mask[i]) continue;
+    Row6 J;
+    sampsonError(consistentRays(matches[i], T), T, &J);
+    H.noalias() += inv_var * J.transpose() * J;
+    const Vec3 d2 = T.R * matches[i].d2;
+    parallax.push_back(std::atan2(matches[i].d1.cross(d2).norm(), matches[i].d1.dot(d2)));
+  }
+  if (!parallax.empty()) {
+    std::nth_element(parallax.begin(), parallax.begin() + parallax.size() / 2, parallax.end());
+    out.median_parallax_rad = parallax[parallax.size() / 2];
+  }
+  const double tn = T.t.norm();
+  if (!(tn > 1e-12)) return out;
+  // Basis [t direction | two directions orthogonal to t | rotation]: the first coordinate is the
+  // metric scale, the next two the translation direction.
+  Mat6 Q = Mat6::Zero();
+  Q.block<3, 1>(0, 0) = T.t / tn;
+  Q.block<3, 2>(0, 1) = tangentBasis(T.t);
+  Q.bottomRightCorner<3, 3>().setIdentity();
+  const Mat6 Hq = Q.transpose() * H * Q;
+  // Marginal information of a block = its Schur complement: the other parameters are free.
+  // A (numerically) singular remainder means that block is not observable either: infinite sigma.
+  auto marginalCovariance = [](const Eigen::MatrixXd& Hm, int first, int size, Eigen::MatrixXd& cov) {
+    const int n = static_cast<int>(Hm.rows());
+    std::vector<int> keep, rest;
+    for (int i = 0; i < n; ++i) (i >= first && i < first + size ? keep : rest).push_back(i);
+    Eigen::MatrixXd Hkk(size, size), Hkr(size, n - size), Hrr(n - size, n - size);
+    for (int a = 0; a < size; ++a) {
+      for (int b = 0; b < size; ++b) Hkk(a, b) = Hm(keep[a], keep[b]);
+      for (int b = 0; b < n - size; ++b) Hkr(a, b) = Hm(keep[a], rest[b]);
+    }
+    for (int a = 0; a < n - size; ++a)
+      for (int b = 0; b < n - size; ++b) Hrr(a, b) = Hm(rest[a], rest[b]);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(Hrr);
+    const double max_ev = std::max(er.eigenvalues().maxCoeff(), Hkk.diagonal().maxCoeff());
+    if (!(er.eigenvalues().minCoeff() > 1e-10 * max_ev)) return false;
+    const Eigen::MatrixXd S = Hkk - Hkr * er.eigenvectors() * er.eigenvalues().cwiseInverse().asDiagonal() *
+                                       er.eigenvectors().transpose() * Hkr.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(S);
+    if (!(es.eigenvalues().minCoeff() > 1e-10 * max_ev)) return false;
+    cov = es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() * es.eigenvectors().transpose();
+    return true;
+  };
+  Eigen::MatrixXd cov;
+  if (central) {
+    // Unit translation: only the direction and the rotation are parameters.
+    const Eigen::MatrixXd H5 = Hq.bottomRightCorner<5, 5>();
+    if (marginalCovariance(H5, 0, 2, cov)) {
+      out.direction_sigma_rad = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(cov).eigenvalues().maxCoeff());
+    }
+    return out;
+  }
+  const Eigen::MatrixXd H6 = Hq;
+  if (marginalCovariance(H6, 0, 1, cov)) out.relative_scale_sigma = std::sqrt(cov(0, 0)) / tn;
+  if (marginalCovariance(H6, 1, 2, cov)) {
+    out.direction_sigma_rad = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(cov).eigenvalues().maxCoeff()) / tn;
+  }
+  return out;
+}
+
+}  // namespace mcslam::relative_pose_detail
