@@ -1,0 +1,233 @@
+#include "mcslam/backend/sliding_window_solver.hpp"
+
+#include "marginalizer.hpp"
+#include "mcslam/backend/reprojection_residual.hpp"
+#include "reduced_system_solver.hpp"
+#include "window_linearization.hpp"
+#include "window_storage.hpp"
+
+namespace mcslam::backend {
+
+const char* statusName(Status s) {
+  switch (s) {
+    case Status::Ok: return "ok";
+    case Status::UnknownKeyframe: return "unknown keyframe";
+    case Status::UnknownLandmark: return "unknown landmark";
+    case Status::UnknownObservation: return "unknown observation";
+    case Status::DuplicateId: return "duplicate id";
+    case Status::CapacityExceeded: return "capacity exceeded";
+    case Status::InvalidCamera: return "invalid camera";
+    case Status::InvalidValue: return "invalid value";
+    case Status::EmptyWindow: return "empty window";
+  }
+  return "?";
+}
+
+namespace {
+int countFreeExtrinsics(const Rig& rig, const SolverOptions& options) {
+  return options.refine_extrinsics && rig.size() > 1 ? rig.size() - 1 : 0;
+}
+}  // namespace
+
+struct SlidingWindowSolver::Impl {
+  Impl(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& opts)
+      : options(opts),
+        window(rig, capacity, opts),
+        prior(6 * countFreeExtrinsics(rig, opts)),
+        linearization(window, opts),
+        reduced(capacity.max_keyframes + rig.size()),
+        marginalizer(window, opts) {
+    outliers.reserve(capacity.max_observations);
+    marginalized.reserve(capacity.max_landmarks);
+  }
+
+  SolveSummary solve(int max_iterations);
+  void classifyOutliers();
+
+  SolverOptions options;
+  WindowStorage window;
+  MarginalizationPrior prior;
+  WindowLinearization linearization;
+  ReducedSystemSolver reduced;
+  Marginalizer marginalizer;
+  std::vector<ObservationKey> outliers;
+  std::vector<int64_t> marginalized;
+};
+
+SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
+  SolveSummary summary;
+  const int analyses_before = reduced.analyses();
+  WindowLinearization& lin = linearization;
+  if (!lin.prepare(window)) {
+    summary.failed = true;
+    classifyOutliers();
+    summary.outliers = static_cast<int>(outliers.size());
+    return summary;
+  }
+  lin.linearize(window, prior, /*select_landmarks=*/true);
+  double cost = lin.cost();
+  summary.initial_cost = cost;
+
+  // Levenberg-Marquardt in trust-region form: mu = 1 / radius, the radius grows with good
+  // steps (by the gain ratio) and shrinks by a growing factor after rejected ones.
+  double radius = options.initial_trust_radius;
+  double decrease_factor = 2.0;
+  constexpr double kMinRelativeDecrease = 1e-3;
+  constexpr double kMinRadius = 1e-32, kMaxRadius = 1e16;
+  for (int iter = 0; iter < max_iterations; ++iter) {
+    const double mu = 1.0 / radius;
+    lin.buildReducedSystem(mu, prior);
+    if (lin.maxGradient() <= options.gradient_tolerance) {
+      summary.converged = true;
+      break;
+    }
+    reduced.setStructure(lin.numBlocks(), lin.blockPattern());
+    ++summary.iterations;
+    const bool solved =
+        lin.numBlocks() == 0 || reduced.solve(lin.reducedMatrix(), lin.reducedRhs(), lin.cameraStep());
+    bool accepted = false;
+    if (solved) {
+      lin.backSubstitute();
+      const double step2 = lin.stepSquaredNorm();
+      const double tol = options.parameter_tolerance;
+      if (std::sqrt(step2) <= tol * (std::sqrt(lin.stateSquaredNorm(window)) + tol)) {
+        summary.converged = true;
+        break;
+      }
+      const double predicted = lin.modelCostDecrease(mu);
+      double new_cost = 0;
+      if (predicted > 0 && lin.evaluateTrial(window, prior, new_cost)) {
+        const double gain = (cost - new_cost) / predicted;
+        if (gain > kMinRelativeDecrease) {
+          accepted = true;
+          lin.commitTrial(window);
+          ++summary.accepted_steps;
+          const double previous = cost;
+          lin.linearize(window, prior, /*select_landmarks=*/false);
+          cost = lin.cost();
+          const double t = 2.0 * gain - 1.0;
+          radius = std::min(kMaxRadius, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
+          decrease_factor = 2.0;
+          if ((previous - cost) <= options.function_tolerance * previous) {
+            summary.converged = true;
+            break;
+          }
+        }
+      }
+    }
+    if (!accepted) {
+      radius /= decrease_factor;
+      decrease_factor *= 2.0;
+      if (radius < kMinRadius) break;
+    }
+  }
+  summary.final_cost = cost;
+  summary.symbolic_analyses = reduced.analyses() - analyses_before;
+  summary.landmarks_used = lin.landmarksUsed();
+  summary.landmarks_skipped = lin.landmarksSkipped();
+  summary.residuals_used = lin.residualsUsed();
+  classifyOutliers();
+  summary.outliers = static_cast<int>(outliers.size());
+  return summary;
+}
+
+void SlidingWindowSolver::Impl::classifyOutliers() {
+  outliers.clear();
+  for (const ObservationState& ob : window.observations) {
+    if (!ob.used) continue;
+    const KeyframeState& kf = window.keyframes[ob.keyframe];
+    const LandmarkState& lm = window.landmarks[ob.landmark];
+    Vec2 r;
+    const bool ok = reprojectionResidualInverse(window.rig().model(ob.camera), kf.T_w_b.inverse(),
+                                                window.extrinsics[ob.camera].T.inverse(), lm.p_w, ob.uv,
+                                                ob.inv_sigma, r, nullptr);
+    if (!ok || r.squaredNorm() > options.outlier_chi2) outliers.push_back({kf.id, lm.id, ob.camera});
+  }
+}
+
+SlidingWindowSolver::SlidingWindowSolver(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& options)
+    : impl_(std::make_unique<Impl>(rig, capacity, options)) {}
+SlidingWindowSolver::~SlidingWindowSolver() = default;
+
+Status SlidingWindowSolver::addKeyframe(int64_t id, const SE3& T_w_b) {
+  impl_->outliers.clear();
+  return impl_->window.addKeyframe(id, T_w_b);
+}
+Status SlidingWindowSolver::addLandmark(int64_t id, const Vec3& p_w) {
+  impl_->outliers.clear();
+  return impl_->window.addLandmark(id, p_w);
+}
+Status SlidingWindowSolver::addObservation(int64_t keyframe_id, int64_t landmark_id, int camera, const Vec2& uv,
+                                           double sigma_px) {
+  return impl_->window.addObservation(keyframe_id, landmark_id, camera, uv, sigma_px);
+}
+Status SlidingWindowSolver::removeObservation(const ObservationKey& key) {
+  return impl_->window.removeObservation(key);
+}
+Status SlidingWindowSolver::removeLandmark(int64_t id) { return impl_->window.removeLandmark(id); }
+
+Status SlidingWindowSolver::setKeyframeFixed(int64_t id, bool fixed) {
+  const int s = impl_->window.keyframeSlot(id);
+  if (s < 0) return Status::UnknownKeyframe;
+  impl_->window.keyframes[s].fixed_by_caller = fixed;
+  return Status::Ok;
+}
+Status SlidingWindowSolver::setKeyframePose(int64_t id, const SE3& T_w_b) {
+  const int s = impl_->window.keyframeSlot(id);
+  if (s < 0) return Status::UnknownKeyframe;
+  if (!T_w_b.R.allFinite() || !T_w_b.t.allFinite()) return Status::InvalidValue;
+  impl_->window.keyframes[s].T_w_b = T_w_b;
+  return Status::Ok;
+}
+Status SlidingWindowSolver::setLandmarkPosition(int64_t id, const Vec3& p_w) {
+  const int s = impl_->window.landmarkSlot(id);
+  if (s < 0) return Status::UnknownLandmark;
+  if (!p_w.allFinite()) return Status::InvalidValue;
+  impl_->window.landmarks[s].p_w = p_w;
+  return Status::Ok;
+}
+
+SolveSummary SlidingWindowSolver::solve(int max_iterations) { return impl_->solve(max_iterations); }
+std::span<const ObservationKey> SlidingWindowSolver::outliers() const { return impl_->outliers; }
+
+Status SlidingWindowSolver::marginalizeOldest() {
+  impl_->outliers.clear();
+  return impl_->marginalizer.marginalizeOldest(impl_->window, impl_->prior, impl_->marginalized);
+}
+std::span<const int64_t> SlidingWindowSolver::marginalizedLandmarks() const { return impl_->marginalized; }
+
+bool SlidingWindowSolver::keyframePose(int64_t id, SE3& T_w_b) const {
+  const int s = impl_->window.keyframeSlot(id);
+  if (s < 0) return false;
+  T_w_b = impl_->window.keyframes[s].T_w_b;
+  return true;
+}
+bool SlidingWindowSolver::landmarkPosition(int64_t id, Vec3& p_w) const {
+  const int s = impl_->window.landmarkSlot(id);
+  if (s < 0) return false;
+  p_w = impl_->window.landmarks[s].p_w;
+  return true;
+}
+const SE3& SlidingWindowSolver::extrinsic(int camera) const { return impl_->window.extrinsics.at(camera).T; }
+Rig SlidingWindowSolver::refinedRig() const {
+  Rig rig = impl_->window.rig();
+  for (int c = 0; c < rig.size(); ++c) rig.cameras[c].T_b_c = impl_->window.extrinsics[c].T;
+  return rig;
+}
+std::optional<int64_t> SlidingWindowSolver::oldestKeyframe() const {
+  const int s = impl_->window.oldestKeyframe();
+  if (s < 0) return std::nullopt;
+  return impl_->window.keyframes[s].id;
+}
+int SlidingWindowSolver::numKeyframes() const { return impl_->window.num_keyframes; }
+int SlidingWindowSolver::numLandmarks() const { return impl_->window.num_landmarks; }
+int SlidingWindowSolver::numObservations() const { return impl_->window.num_observations; }
+bool SlidingWindowSolver::isFull() const {
+  return impl_->window.num_keyframes >= impl_->window.capacity().max_keyframes;
+}
+const Eigen::MatrixXd& SlidingWindowSolver::priorInformation() const { return impl_->prior.H; }
+bool SlidingWindowSolver::extrinsicInPrior(int camera) const { return impl_->window.extrinsics.at(camera).in_prior; }
+size_t SlidingWindowSolver::cholmodArenaPeakBytes() const { return impl_->reduced.arena().peakBytes(); }
+size_t SlidingWindowSolver::cholmodArenaOverflows() const { return impl_->reduced.arena().overflows(); }
+
+}  // namespace mcslam::backend

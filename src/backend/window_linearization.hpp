@@ -1,0 +1,124 @@
+#pragma once
+// One Levenberg-Marquardt problem over the window: which variables are free (the gauge), which
+// landmarks enter, the residuals and Jacobians at the current state, the damped reduced camera
+// system after eliminating the landmarks (Schur complement on 3x3 blocks), the landmark
+// back-substitution, and the cost at a trial step. Every buffer is sized at construction.
+#include <Eigen/Core>
+#include <vector>
+
+#include "marginalization_prior.hpp"
+#include "window_storage.hpp"
+
+namespace mcslam::backend {
+
+class WindowLinearization {
+ public:
+  WindowLinearization(const WindowStorage& window, const SolverOptions& options);
+
+  // Chooses the free variables (gauge) and collects the landmarks with >= 2 observations.
+  // False when there is nothing to optimize.
+  bool prepare(const WindowStorage& window);
+  // Residuals, robust weights and Jacobians at the current state. `select_landmarks` (first call
+  // of a solve) drops observations that do not project and landmarks that are not constrained.
+  void linearize(const WindowStorage& window, const MarginalizationPrior& prior, bool select_landmarks);
+  double cost() const { return cost_; }
+  double maxGradient() const;
+
+  // Damped reduced system (H_cc + mu D_c - W (H_ll + mu D_l)^-1 W^T) and its right-hand side.
+  void buildReducedSystem(double mu, const MarginalizationPrior& prior);
+  int numBlocks() const { return num_blocks_; }
+  int maxBlocks() const { return max_blocks_; }
+  const uint8_t* blockPattern() const { return pattern_.data(); }
+  const double* reducedMatrix() const { return S_.data(); }  // leading dimension 6 * maxBlocks()
+  const double* reducedRhs() const { return rhs_.data(); }
+  double* cameraStep() { return dx_c_.data(); }
+
+  // Landmark steps from the camera step in cameraStep(); then the predicted cost decrease and
+  // the squared norms of the step and of the state (for the parameter tolerance).
+  void backSubstitute();
+  double modelCostDecrease(double mu) const;
+  double stepSquaredNorm() const;
+  double stateSquaredNorm(const WindowStorage& window) const;
+
+  // Cost at state (+) step; false when an observation stops projecting there.
+  bool evaluateTrial(const WindowStorage& window, const MarginalizationPrior& prior, double& cost);
+  void commitTrial(WindowStorage& window) const;
+
+  int landmarksUsed() const { return landmarks_used_; }
+  int landmarksSkipped() const { return landmarks_skipped_; }
+  int residualsUsed() const { return residuals_used_; }
+
+ private:
+  struct ObservationRef {
+    int slot;
+    int pose_block;  // -1: keyframe held fixed
+    int ext_block;   // -1: extrinsic not refined
+    bool active;
+  };
+  struct ObservationLin {
+    Vec2 r;    // sqrt(weight) * whitened residual
+    Mat26 Jp;  // sqrt(weight) * Jacobians
+    Mat26 Je;
+    Mat23 Jl;
+  };
+  struct LandmarkLin {
+    int slot;
+    int begin, end;  // observation range
+    bool active;
+    Mat3 H_inv;      // (H_ll + mu D_l)^-1 of the last build
+    Vec3 g;
+    Vec3 D;
+    Vec3 dx;
+    Vec3 p_trial;
+  };
+
+  void updateTransforms(const WindowStorage& window);
+  double priorCost(const WindowStorage& window, const MarginalizationPrior& prior, bool trial) const;
+
+  const SolverOptions options_;
+  int max_blocks_;
+  int ld_;
+  int num_cameras_;
+  int num_ext_vars_ = 0;
+  std::vector<int> ext_var_of_camera_;
+
+  // Variables of this solve.
+  std::vector<int> pose_block_;  // per keyframe slot
+  std::vector<int> ext_block_;   // per camera
+  int num_blocks_ = 0;
+  std::vector<SE3> T_b_w_;       // per keyframe slot
+  std::vector<SE3> T_c_b_;       // per camera, current
+  std::vector<SE3> T_c_b_jac_;   // per camera, where Jacobians are evaluated (first estimate)
+  std::vector<bool> use_fej_;
+
+  std::vector<LandmarkLin> landmarks_;
+  int num_landmarks_ = 0;
+  std::vector<ObservationRef> refs_;
+  std::vector<ObservationLin> lin_;
+  int num_refs_ = 0;
+  std::vector<Vec6> prior_r_;    // calibration prior per camera
+  std::vector<Mat6> prior_J_;
+  double cost_ = 0;
+  int landmarks_used_ = 0, landmarks_skipped_ = 0, residuals_used_ = 0;
+
+  // Reduced camera system.
+  Eigen::MatrixXd S_;
+  Eigen::VectorXd g_c_;     // gradient of the camera variables (before elimination)
+  Eigen::VectorXd D_c_;     // clamped diagonal of H_cc
+  Eigen::VectorXd rhs_;     // -(reduced gradient)
+  Eigen::VectorXd dx_c_;
+  Eigen::VectorXd d_current_;         // stacked extrinsic d at the linearization
+  mutable Eigen::VectorXd d_eval_;    // stacked d where the prior is evaluated
+  double max_gradient_ = 0;
+  std::vector<uint8_t> pattern_;
+  std::vector<Eigen::Matrix<double, 6, 3>> W_;  // per touched block of one landmark
+  std::vector<int> touched_;
+  std::vector<int> touched_slot_;
+
+  // Trial state.
+  std::vector<SE3> kf_trial_;
+  std::vector<SE3> ext_trial_;
+  std::vector<Vec6> ext_d_trial_;
+};
+
+}  // namespace mcslam::backend
