@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "mcslam/dataset/dataset.hpp"
 #include "test_support.hpp"
 
 using namespace mcslam;
@@ -112,4 +113,30 @@ TEST(EvalCli, KittiFormatWithIndexTimes) {
   ASSERT_EQ(test::runCommand(tool() + " ape " + g + " " + e + " --format kitti --align none --json", &out), 0) << out;
   EXPECT_TRUE(contains(out, "\"pairs\": 6")) << out;
   EXPECT_TRUE(contains(out, "\"rmse\": 0.1")) << out;
+}
+
+TEST(EvalCli, ReferenceCanBeADatasetFolderWithGroundTruth) {
+  test::TempDir dir("eval-cli");
+  Trajectory gt, est;
+  for (int i = 0; i < 10; ++i) {
+    gt.push_back({1000000000LL * i, SE3(Mat3::Identity(), Vec3(i, 0.1 * i * i, 0))});
+    est.push_back({1000000000LL * i + 2000000, SE3(Mat3::Identity(), Vec3(i, 0.1 * i * i, 0.25))});
+  }
+  Rig rig;
+  rig.cameras.push_back({"cam0", CameraModel(8, 8, 10, 10, 3.5, 3.5, Distortion::None), SE3(), 0});
+  {
+    AslDatasetWriter w(dir.file("asl"), rig);
+    w.writeGroundTruth(gt);
+    w.close();
+  }
+  writeTumTrajectory(dir.file("est.txt"), est);
+  std::string out;
+  ASSERT_EQ(test::runCommand(tool() + " ape " + dir.file("asl") + " " + dir.file("est.txt") + " --align none --json", &out), 0)
+      << out;
+  EXPECT_TRUE(contains(out, "\"pairs\": 10")) << out;
+  EXPECT_TRUE(contains(out, "\"rmse\": 0.25")) << out;
+  // A folder without ground truth is a clear error.
+  std::filesystem::remove(dir.file("asl/groundtruth.txt"));
+  EXPECT_EQ(test::runCommand(tool() + " ape " + dir.file("asl") + " " + dir.file("est.txt"), &out), 2);
+  EXPECT_TRUE(contains(out, "the dataset has no ground truth")) << out;
 }

@@ -2,10 +2,12 @@
 // conventions (association by nearest timestamp, Umeyama alignment, numpy statistics).
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "eval_report.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/dataset/dataset.hpp"
 #include "mcslam/dataset/trajectory.hpp"
 
 using namespace mcslam;
@@ -24,7 +26,9 @@ struct CommonArgs {
 };
 
 void addCommon(CLI::App* cmd, CommonArgs& a) {
-  cmd->add_option("GT", a.reference, "Reference (ground truth) trajectory")->required();
+  cmd->add_option("GT", a.reference,
+                  "Reference (ground truth) trajectory, or a dataset folder (ASL, EuRoC, KITTI) to use its ground truth")
+      ->required();
   cmd->add_option("EST", a.estimate, "Estimated trajectory")->required();
   cmd->add_option("--align", a.align,
                   "Alignment of the estimate onto the reference before measuring: se3 (rotation and translation, "
@@ -49,6 +53,11 @@ void addCommon(CLI::App* cmd, CommonArgs& a) {
 }
 
 Trajectory load(const std::string& path, const std::string& format, const std::string& times) {
+  if (std::filesystem::is_directory(path)) {
+    const Dataset ds = Dataset::open(path);
+    if (!ds.groundTruth()) throw InputError(path + ": the dataset has no ground truth");
+    return *ds.groundTruth();
+  }
   if (format == "kitti") return readKittiTrajectory(path, times);
   if (!times.empty()) throw InputError(times + ": a times file only goes with --format kitti");
   return readTumTrajectory(path);

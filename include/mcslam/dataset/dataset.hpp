@@ -29,15 +29,16 @@ struct RigFrameEntry {
 };
 
 struct DatasetOptions {
-  // Calibration file to use instead of the dataset's own.
+  // Calibration to use instead of the dataset's own (anything loadRigFromPath reads); its camera i reads
+  // the dataset's camera i (camN/, image_N/).
   std::string calibration_override;
   // Cameras to keep, by calibration index (empty = all). The body frame stays the full rig's.
   std::vector<int> cameras;
-  // Largest difference between stamps of one rig frame; 0 = automatic (a third of the median frame period,
-  // at most 5 ms).
+  // Largest difference between stamps of one rig frame; 0 = automatic (a third of the shortest per-camera
+  // median frame period, at most 5 ms).
   Timestamp sync_tolerance_ns = 0;
   // Ground truth file to use instead of the dataset's own: TUM (body pose in the world) for ASL and EuRoC,
-  // KITTI poses (cam0, times from times.txt) for KITTI.
+  // KITTI poses (cam0, times from times.txt) for KITTI; for EuRoC a .csv is read as EuRoC ground truth (IMU).
   std::string ground_truth_path;
 };
 
