@@ -1,0 +1,48 @@
+#pragma once
+// Map initialization (paper section IV-B). From one rig frame when it has enough metric multi-view
+// features; otherwise from two frames, with the generalized relative pose (17-point in RANSAC) for
+// rigs of several cameras and the 5-point algorithm for one camera, after a parallax and
+// observability check. The two-frame path runs rarely and may allocate.
+#include <vector>
+
+#include "mcslam/features/frame_features.hpp"
+#include "mcslam/geometry/relative_pose.hpp"
+#include "mcslam/odometry/odometry_options.hpp"
+
+namespace mcslam {
+
+class Initializer {
+ public:
+  Initializer(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
+
+  // Metric multi-view features in the frame.
+  static int metricMultiView(const FrameFeatures& f);
+  bool oneFrameReady(const FrameFeatures& f) const { return metricMultiView(f) >= options_.init_min_multiview; }
+
+  enum class TwoFrame { Waiting, Ready };
+  // Feeds a frame to the two-frame initialization. Ready: T_ref_cur (current body frame -> reference body
+  // frame; metric for a rig, unit translation for one camera) is set and reference() is the first frame.
+  TwoFrame feed(const FrameFeatures& f, uint64_t frame_index, SE3& T_ref_cur);
+  const FrameFeatures& reference() const { return reference_; }
+  uint64_t referenceIndex() const { return reference_index_; }
+  bool hasReference() const { return has_reference_; }
+  void reset() { has_reference_ = false; }
+  // Why the last attempt waited (for logs).
+  RelativePoseStatus lastStatus() const { return last_status_; }
+  int lastMatches() const { return last_matches_; }
+
+ private:
+  int matchToReference(const FrameFeatures& f);
+
+  const Rig& rig_;
+  OdometryOptions options_;
+  FrameFeatures reference_;
+  uint64_t reference_index_ = 0;
+  bool has_reference_ = false;
+  std::vector<RelativeCorrespondence> correspondences_;
+  std::vector<int32_t> best_of_ref_;
+  RelativePoseStatus last_status_ = RelativePoseStatus::TooFewCorrespondences;
+  int last_matches_ = 0;
+};
+
+}  // namespace mcslam

@@ -1,0 +1,78 @@
+#pragma once
+// Keyframe insertion (paper IV-C, last paragraph) and the back-end (V): a new keyframe takes the
+// landmarks tracked in it, new landmarks come from its metric multi-view features and from its
+// unmatched keypoints matched along epipolar curves into the previous keyframes (any camera to any
+// camera), weak landmarks are culled, and the sliding window is optimized.
+#include <memory>
+#include <vector>
+
+#include "mcslam/backend/sliding_window_solver.hpp"
+#include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/odometry_options.hpp"
+#include "mcslam/odometry/projection_search.hpp"
+
+namespace mcslam {
+
+class LocalMapper {
+ public:
+  LocalMapper(const Rig& rig, const OdometryOptions& options, Map& map, int max_features_per_camera);
+  ~LocalMapper();
+
+  // Inserts the frame as a keyframe at T_w_b, linking the keypoints matched in `matches`. With
+  // `create_multiview_points`, metric multi-view features without a landmark become landmarks.
+  // Returns the keyframe slot (-1 when the map cannot take it).
+  int insertKeyframe(const FrameFeatures& frame, const FrameMatches* matches, const SE3& T_w_b, uint64_t frame_index,
+                     bool create_multiview_points = true);
+
+  // New landmarks from keyframe `slot`'s unmatched keypoints and those of the previous keyframes.
+  int triangulateWithPrevious(int slot);
+
+  // Runs the sliding-window optimization including keyframe `slot` and writes the results back into
+  // the map. Returns false when the back-end is off or failed.
+  bool optimize(int slot);
+
+  // Erases landmarks that are rarely found where predicted, or that never got a second keyframe.
+  int cull(int newest_slot);
+
+  void reset();
+  Rig refinedRig() const;
+  double lastBackendMs() const { return last_backend_ms_; }
+  uint64_t backendSolves() const { return backend_solves_; }
+
+ private:
+  int allocateKeyframe();
+  void linkMultiViewPartners(int slot, const FrameFeatures& frame);
+  void touch(int lm);
+  void finishTouched();
+  void backendRemoveLandmark(int lm);
+  int keyframeSlotOfId(int64_t id) const;
+
+  const Rig& rig_;
+  OdometryOptions options_;
+  Map& map_;
+  std::unique_ptr<backend::SlidingWindowSolver> solver_;
+  std::vector<int32_t> touched_;
+  std::vector<uint8_t> touched_flag_;
+  int touched_count_ = 0;
+  std::vector<double> half_fov_;  // per camera: angle from the optical axis to the image corner
+  // Scratch for epipolar matching into a previous keyframe.
+  struct Candidate {
+    int16_t cam_new, cam_old;
+    int32_t kp_new, kp_old;
+    int16_t distance;
+  };
+  std::vector<Candidate> candidates_;
+  std::vector<int32_t> claim_;       // per (camera, keypoint) of the old keyframe: best candidate index
+  std::vector<uint32_t> visited_;    // per keypoint of the old keyframe: stamp of the last visit
+  uint32_t stamp_ = 0;
+  std::vector<TriangulationObservation> tri_obs_;
+  std::vector<KeypointRef> tri_refs_;  // keyframe-tagged refs in tri_obs_ order (cam, index)
+  std::vector<int32_t> tri_kf_;        // keyframe slot of each tri_obs_ entry
+  std::vector<backend::ObservationKey> outliers_;
+  int capacity_;
+  bool monocular_ = false;
+  double last_backend_ms_ = 0;
+  uint64_t backend_solves_ = 0;
+};
+
+}  // namespace mcslam

@@ -1,0 +1,104 @@
+#pragma once
+// Visual odometry for a generalized camera (paper sections IV-B, IV-C, V): initialization, tracking
+// of every frame against the local map, keyframes, new landmarks from multi-view features and from
+// rays of different cameras and times, and the sliding-window back-end. Works for one camera, for
+// overlapping and for non-overlapping rigs alike. All memory is allocated at construction.
+#include <memory>
+#include <vector>
+
+#include "mcslam/backend/sliding_window_solver.hpp"
+#include "mcslam/geometry/absolute_pose_ransac.hpp"
+#include "mcslam/geometry/pose_refinement.hpp"
+#include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/odometry_options.hpp"
+#include "mcslam/odometry/projection_search.hpp"
+#include "mcslam/pipeline/frame_processor.hpp"
+
+namespace mcslam {
+
+// Counters for the stats file.
+struct OdometryStats {
+  uint64_t frames = 0;
+  uint64_t tracking = 0;
+  uint64_t not_initialized = 0;
+  uint64_t lost = 0;
+  uint64_t initializations = 0;
+  uint64_t keyframes = 0;
+  uint64_t recoveries = 0;          // frames tracked only through the descriptor fallback
+  uint64_t backend_solves = 0;
+  double last_backend_ms = 0;
+};
+
+// Milliseconds spent in the stages of the last processed frame.
+struct OdometryTiming {
+  double tracking_ms = 0;   // pose estimation and keyframe decision
+  double mapping_ms = 0;    // keyframe insertion and new landmarks
+  double backend_ms = 0;    // sliding-window optimization
+};
+
+class Initializer;
+class LocalMapper;
+
+class Odometry {
+ public:
+  Odometry(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
+  ~Odometry();
+  Odometry(const Odometry&) = delete;
+  Odometry& operator=(const Odometry&) = delete;
+
+  // Estimates the pose of one rig frame whose features (and multi-view features) are computed.
+  void process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
+
+  const OdometryStats& stats() const { return stats_; }
+  const OdometryTiming& timing() const { return timing_; }
+  const Map& map() const { return map_; }
+  // The rig with the extrinsics the back-end refined (the calibration when refinement is off).
+  Rig refinedRig() const;
+  bool initialized() const { return initialized_; }
+  // Frame index of the reference frame of the last initialization when it used two frames (the frames
+  // between the two have no estimate of their own), -1 when it used one frame.
+  int64_t lastInitializationReference() const { return last_init_reference_; }
+
+ private:
+  enum class TrackResult { Ok, Failed };
+  void initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
+  TrackResult track(const FrameFeatures& frame, uint64_t frame_index, SE3& T_w_b, int& inliers);
+  // Pose from the current matches (RANSAC or refinement from `guess`); drops the outlier matches and
+  // returns the number of inliers (0 on failure).
+  int poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b);
+  bool needKeyframe(const SE3& T_w_b, int inliers, uint64_t frame_index) const;
+  int countKeyframeLandmarks(int slot) const;
+  void resetMap();
+  void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
+
+  Rig rig_;
+  OdometryOptions options_;
+  int capacity_;
+  Map map_;
+  ProjectionSearch search_;
+  FrameMatches matches_;
+  AbsolutePoseRansac ransac_;
+  PoseRefiner refiner_;
+  std::unique_ptr<Initializer> initializer_;
+  std::unique_ptr<LocalMapper> mapper_;
+
+  std::vector<PoseObservation> observations_;  // built from matches_
+  std::vector<KeypointRef> observation_refs_;  // which keypoint each observation is
+  std::vector<int32_t> last_tracked_;          // landmark slots tracked in the previous frame
+  int last_tracked_count_ = 0;
+
+  bool initialized_ = false;
+  bool have_velocity_ = false;
+  SE3 T_w_last_;                  // pose of the previous frame (valid when initialized)
+  SE3 velocity_;                  // T_last_prev^-1 ... relative motion of the last frame step
+  SE3 anchor_;                    // pose given to the next initialization (continuity after a loss)
+  uint64_t last_keyframe_frame_ = 0;
+  SE3 last_keyframe_pose_;
+  int last_keyframe_tracked_ = 0;
+  int lost_frames_ = 0;
+  int64_t last_init_reference_ = -1;
+  OdometryStats stats_;
+  OdometryTiming timing_;
+};
+
+}  // namespace mcslam

@@ -1,0 +1,45 @@
+#pragma once
+// The front-end of a rig frame (paper section IV-A): ORB in every camera on the per-camera workers, then
+// the multi-view features between overlapping cameras. Owns the overlap map, computed once.
+#include <memory>
+
+#include "mcslam/features/feature_workers.hpp"
+#include "mcslam/features/frame_features.hpp"
+#include "mcslam/features/multiview_matcher.hpp"
+#include "mcslam/pipeline/frame_processor.hpp"
+#include "mcslam/pipeline/pipeline_config.hpp"
+
+namespace mcslam {
+
+struct FrontEndTiming {
+  double extraction_ms = 0;
+  double multiview_ms = 0;
+};
+
+class FrontEnd {
+ public:
+  FrontEnd(const Rig& rig, const PipelineConfig& config);
+
+  // Fills `out` for the frame. Images whose size differs from the calibration are treated as absent
+  // (and counted): a wrong image never reaches the geometry.
+  void compute(const RigFrameView& frame, FrameFeatures& out);
+
+  const OverlapMap& overlap() const { return overlap_; }
+  const FrontEndTiming& timing() const { return timing_; }
+  const MultiViewStats& multiViewStats() const { return matcher_.stats(); }
+  uint64_t rejectedImages() const { return rejected_images_; }
+  int capacityPerCamera() const { return capacity_; }
+
+ private:
+  const Rig& rig_;
+  int capacity_;
+  OverlapMap overlap_;
+  FeatureWorkers workers_;
+  MultiViewMatcher matcher_;
+  std::vector<ImageView> images_;
+  std::unique_ptr<bool[]> present_;
+  FrontEndTiming timing_;
+  uint64_t rejected_images_ = 0;
+};
+
+}  // namespace mcslam

@@ -1,0 +1,42 @@
+#pragma once
+// The whole SLAM pipeline behind the FrameProcessor boundary: front-end, odometry and back-end.
+#include "mcslam/odometry/odometry.hpp"
+#include "mcslam/pipeline/front_end.hpp"
+
+namespace mcslam {
+
+// Milliseconds spent on the last frame, by stage (the paper's Table III split).
+struct PipelineTiming {
+  double features_ms = 0;      // ORB extraction and multi-view features
+  double tracking_ms = 0;      // pose estimation, keyframe decision, new landmarks
+  double optimization_ms = 0;  // sliding-window back-end
+  double total_ms = 0;
+};
+
+class SlamPipeline final : public FrameProcessor {
+ public:
+  SlamPipeline(const Rig& rig, const PipelineConfig& config);
+
+  void process(const RigFrameView& frame, PoseEstimate& out) override;
+
+  const PipelineTiming& timing() const { return timing_; }
+  const OdometryStats& stats() const { return odometry_.stats(); }
+  const FrameFeatures& lastFeatures() const { return features_; }
+  const FrontEnd& frontEnd() const { return front_end_; }
+  const Odometry& odometry() const { return odometry_; }
+  Rig refinedRig() const { return odometry_.refinedRig(); }
+  const PipelineConfig& config() const { return config_; }
+
+ private:
+  Rig rig_;
+  PipelineConfig config_;
+  FrontEnd front_end_;
+  Odometry odometry_;
+  FrameFeatures features_;
+  PipelineTiming timing_;
+};
+
+// Resolves `refine_extrinsics: auto` for the rig and overlap.
+OdometryOptions effectiveOdometryOptions(const PipelineConfig& config, const OverlapMap& overlap);
+
+}  // namespace mcslam

@@ -1,0 +1,111 @@
+#include "mcslam/odometry/initializer.hpp"
+
+#include <algorithm>
+
+namespace mcslam {
+
+Initializer::Initializer(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
+    : rig_(rig), options_(options) {
+  reference_.allocate(rig.size(), max_features_per_camera);
+  correspondences_.reserve(static_cast<std::size_t>(rig.size()) * max_features_per_camera);
+  best_of_ref_.resize(max_features_per_camera);
+}
+
+int Initializer::metricMultiView(const FrameFeatures& f) {
+  int n = 0;
+  for (int t = 0; t < f.mv_count; ++t) n += f.mv[t].has_point ? 1 : 0;
+  return n;
+}
+
+// Mutual nearest neighbours by descriptor between the reference and the frame, camera by camera,
+// with a ratio test. No geometric prior: the rig may have turned a lot since the reference.
+int Initializer::matchToReference(const FrameFeatures& f) {
+  correspondences_.clear();
+  constexpr int kMaxHamming = 60;
+  constexpr float kRatio = 0.8f;
+  for (int c = 0; c < f.cameras(); ++c) {
+    if (!f.present[c] || !reference_.present[c]) continue;
+    const FeatureSet& ref = reference_.sets[c];
+    const FeatureSet& cur = f.sets[c];
+    std::fill(best_of_ref_.begin(), best_of_ref_.begin() + ref.count, -1);
+    // Best current keypoint of every reference keypoint (for the mutual check).
+    for (int r = 0; r < ref.count; ++r) {
+      int best = 257, best_k = -1;
+      for (int k = 0; k < cur.count; ++k) {
+        const int d = hammingDistance(ref.descriptors[r], cur.descriptors[k]);
+        if (d < best) {
+          best = d;
+          best_k = k;
+        }
+      }
+      best_of_ref_[r] = best_k;
+    }
+    for (int k = 0; k < cur.count; ++k) {
+      if (!f.valid[c][k]) continue;
+      int best = 257, second = 257, best_r = -1;
+      for (int r = 0; r < ref.count; ++r) {
+        const int d = hammingDistance(cur.descriptors[k], ref.descriptors[r]);
+        if (d < best) {
+          second = best;
+          best = d;
+          best_r = r;
+        } else if (d < second) {
+          second = d;
+        }
+      }
+      if (best_r < 0 || best > kMaxHamming || !(best < kRatio * second) || best_of_ref_[best_r] != k) continue;
+      if (!reference_.valid[c][best_r]) continue;
+      RelativeCorrespondence m;
+      m.camera1 = c;
+      m.bearing1 = reference_.bearings[c][best_r];
+      m.camera2 = c;
+      m.bearing2 = f.bearings[c][k];
+      correspondences_.push_back(m);
+    }
+  }
+  return static_cast<int>(correspondences_.size());
+}
+
+Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_index, SE3& T_ref_cur) {
+  if (!has_reference_) {
+    reference_ = f;
+    reference_index_ = frame_index;
+    has_reference_ = true;
+    last_status_ = RelativePoseStatus::TooFewCorrespondences;
+    return TwoFrame::Waiting;
+  }
+  last_matches_ = matchToReference(f);
+  const bool too_old = frame_index - reference_index_ > static_cast<uint64_t>(options_.init_max_reference_age);
+  if (last_matches_ < options_.init_min_matches) {
+    // The view changed too much for this reference: start again from this frame.
+    if (too_old || last_matches_ < options_.init_min_matches / 2) {
+      reference_ = f;
+      reference_index_ = frame_index;
+    }
+    last_status_ = RelativePoseStatus::TooFewCorrespondences;
+    return TwoFrame::Waiting;
+  }
+  RelativePoseOptions ro;
+  ro.seed = 1 + frame_index;
+  const double f_mean = 0.5 * (rig_.model(0).fx() + rig_.model(0).fy());
+  ro.bearing_sigma_rad = 0.7 / f_mean;  // keypoints at the finest octave: ~0.7 px; inliers within 3 sigma
+  ro.min_inliers = std::max(20, options_.init_min_matches / 2);
+  RelativePoseResult r;
+  if (rig_.size() == 1) {
+    r = estimateCentralRelativePose(correspondences_, ro);
+  } else {
+    r = estimateGeneralizedRelativePose(rig_, correspondences_, ro);
+  }
+  last_status_ = r.status;
+  if (!r.ok()) return TwoFrame::Waiting;
+  if (rig_.size() == 1) {
+    // The central solver works in camera frames: bring the motion into the body frame.
+    const SE3& T_b_c = rig_.T_b_c(0);
+    T_ref_cur = T_b_c * r.T_1_2 * T_b_c.inverse();
+  } else {
+    T_ref_cur = r.T_1_2;
+  }
+  return TwoFrame::Ready;
+}
+
+}  // namespace mcslam

@@ -1,0 +1,452 @@
+#include "mcslam/odometry/local_mapper.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace mcslam {
+
+namespace {
+
+double sigmaOf(const Keypoint& kp, float scale_factor) { return std::pow(scale_factor, kp.octave); }
+
+// Angle from the optical axis to the farthest image corner.
+double halfFieldOfView(const CameraModel& m) {
+  double best = 0;
+  for (const Vec2 c : {Vec2(0, 0), Vec2(m.width() - 1, 0), Vec2(0, m.height() - 1), Vec2(m.width() - 1, m.height() - 1)}) {
+    Vec3 b;
+    if (m.unproject(c, b)) best = std::max(best, std::acos(std::clamp(b.z(), -1.0, 1.0)));
+  }
+  return best;
+}
+
+backend::WindowCapacity windowCapacity(const OdometryOptions& o, const Map& map) {
+  backend::WindowCapacity cap;
+  cap.max_keyframes = o.window_keyframes;
+  cap.max_landmarks = map.landmarkCapacity();
+  cap.max_observations = std::min(4 * cap.max_landmarks * o.window_keyframes, 1 << 22);
+  return cap;
+}
+
+backend::SolverOptions solverOptions(const OdometryOptions& o, bool monocular) {
+  backend::SolverOptions so;
+  so.refine_extrinsics = o.refine_extrinsics;
+  so.extrinsic_prior.translation = o.extrinsic_sigma_translation;
+  so.extrinsic_prior.rotation = o.extrinsic_sigma_rotation_deg * M_PI / 180.0;
+  so.gauge_fixed_oldest = monocular ? 2 : 1;  // a monocular map also has a free scale
+  return so;
+}
+
+}  // namespace
+
+LocalMapper::LocalMapper(const Rig& rig, const OdometryOptions& options, Map& map, int max_features_per_camera)
+    : rig_(rig), options_(options), map_(map), capacity_(max_features_per_camera), monocular_(rig.size() == 1) {
+  const int cams = rig.size();
+  touched_.resize(map.landmarkCapacity());
+  touched_flag_.assign(map.landmarkCapacity(), 0);
+  for (const RigCamera& c : rig.cameras) half_fov_.push_back(halfFieldOfView(c.model));
+  candidates_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
+  claim_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
+  visited_.assign(static_cast<std::size_t>(cams) * max_features_per_camera, 0);
+  const int max_obs = 2 * cams;
+  tri_obs_.resize(max_obs);
+  tri_refs_.resize(max_obs);
+  tri_kf_.resize(max_obs);
+  outliers_.resize(static_cast<std::size_t>(cams) * max_features_per_camera * options.window_keyframes);
+  if (options.backend) {
+    solver_ = std::make_unique<backend::SlidingWindowSolver>(rig, windowCapacity(options, map), solverOptions(options, monocular_));
+  }
+}
+
+LocalMapper::~LocalMapper() = default;
+
+void LocalMapper::reset() {
+  if (solver_) {
+    // A fresh window (the old one's keyframes and landmarks are gone with the map). This allocates:
+    // it happens only when tracking was lost, never per frame.
+    const Rig refined = solver_->refinedRig();
+    solver_.reset();
+    solver_ = std::make_unique<backend::SlidingWindowSolver>(refined, windowCapacity(options_, map_),
+                                                             solverOptions(options_, monocular_));
+  }
+  std::fill(touched_flag_.begin(), touched_flag_.end(), 0);
+  touched_count_ = 0;
+}
+
+Rig LocalMapper::refinedRig() const { return solver_ ? solver_->refinedRig() : rig_; }
+
+int LocalMapper::keyframeSlotOfId(int64_t id) const {
+  for (int i = 0; i < map_.keyframeCapacity(); ++i) {
+    if (map_.keyframe(i).alive && map_.keyframe(i).id == id) return i;
+  }
+  return -1;
+}
+
+void LocalMapper::touch(int lm) {
+  if (touched_flag_[lm]) return;
+  touched_flag_[lm] = 1;
+  touched_[touched_count_++] = lm;
+}
+
+void LocalMapper::finishTouched() {
+  for (int i = 0; i < touched_count_; ++i) {
+    const int lm = touched_[i];
+    touched_flag_[lm] = 0;
+    if (map_.landmark(lm).alive) map_.updateLandmarkAppearance(lm, rig_, options_.scale_factor, options_.levels);
+  }
+  touched_count_ = 0;
+}
+
+int LocalMapper::allocateKeyframe() {
+  int slot = map_.createKeyframe();
+  if (slot >= 0) return slot;
+  // The pool is full: drop the oldest keyframe that has left the back-end window.
+  int victim = -1;
+  for (int i = 0; i < map_.keyframeCapacity(); ++i) {
+    const Keyframe& k = map_.keyframe(i);
+    if (k.alive && !k.in_backend && (victim < 0 || k.id < map_.keyframe(victim).id)) victim = i;
+  }
+  if (victim < 0) return -1;
+  // Its landmarks lose their observations there; those left with none die, and leave the back-end first.
+  const Keyframe& v = map_.keyframe(victim);
+  for (int c = 0; c < v.features.cameras(); ++c) {
+    for (int k = 0; k < v.features.sets[c].count; ++k) {
+      const int lm = v.landmark_of[c][k];
+      if (lm < 0) continue;
+      const Landmark& l = map_.landmark(lm);
+      bool elsewhere = false;
+      for (int o = 0; o < l.obs_count && !elsewhere; ++o) elsewhere = l.obs[o].keyframe != victim;
+      if (!elsewhere) backendRemoveLandmark(lm);
+    }
+  }
+  map_.eraseKeyframe(victim);
+  return map_.createKeyframe();
+}
+
+int LocalMapper::insertKeyframe(const FrameFeatures& frame, const FrameMatches* matches, const SE3& T_w_b,
+                                uint64_t frame_index, bool create_multiview_points) {
+  const int slot = allocateKeyframe();
+  if (slot < 0) return -1;
+  Keyframe& kf = map_.keyframe(slot);
+  kf.features = frame;
+  kf.T_w_b = T_w_b;
+  kf.t = frame.t;
+  kf.frame_index = frame_index;
+  for (int c = 0; c < frame.cameras(); ++c) kf.grids[c].build(kf.features.sets[c]);
+
+  if (matches) {
+    for (int c = 0; c < frame.cameras(); ++c) {
+      for (int k = 0; k < frame.sets[c].count; ++k) {
+        const int lm = matches->landmarkOf(c, k);
+        if (lm >= 0 && map_.landmark(lm).alive && map_.addObservation(lm, slot, c, k)) touch(lm);
+      }
+    }
+    linkMultiViewPartners(slot, frame);
+  }
+  if (create_multiview_points) {
+    for (int t = 0; t < frame.mv_count; ++t) {
+      const MultiViewFeature& mv = frame.mv[t];
+      if (!mv.has_point) continue;
+      bool linked = false;
+      for (int r = 0; r < mv.size && !linked; ++r) {
+        const KeypointRef& ref = frame.mv_refs[mv.first + r];
+        linked = kf.landmark_of[ref.cam][ref.index] >= 0;
+      }
+      if (linked) continue;
+      const int lm = map_.createLandmark(T_w_b * mv.p_b, mv.descriptor, kf.id);
+      if (lm < 0) break;  // map full: keep tracking with what we have
+      map_.landmark(lm).metric = true;
+      for (int r = 0; r < mv.size; ++r) {
+        const KeypointRef& ref = frame.mv_refs[mv.first + r];
+        map_.addObservation(lm, slot, ref.cam, ref.index);
+      }
+      touch(lm);
+    }
+  }
+  finishTouched();
+  return slot;
+}
+
+// Keypoints of one multi-view feature see the same point: when one of them was matched to a landmark,
+// the others observe it too if it projects onto them.
+void LocalMapper::linkMultiViewPartners(int slot, const FrameFeatures& frame) {
+  Keyframe& kf = map_.keyframe(slot);
+  for (int t = 0; t < frame.mv_count; ++t) {
+    const MultiViewFeature& mv = frame.mv[t];
+    int lm = -1;
+    for (int r = 0; r < mv.size && lm < 0; ++r) {
+      const KeypointRef& ref = frame.mv_refs[mv.first + r];
+      lm = kf.landmark_of[ref.cam][ref.index];
+    }
+    if (lm < 0) continue;
+    const Landmark& l = map_.landmark(lm);
+    for (int r = 0; r < mv.size; ++r) {
+      const KeypointRef& ref = frame.mv_refs[mv.first + r];
+      if (kf.landmark_of[ref.cam][ref.index] >= 0) continue;
+      const Keypoint& kp = frame.sets[ref.cam].keypoints[ref.index];
+      Vec2 uv;
+      const Vec3 p_c = (kf.T_w_b * rig_.T_b_c(ref.cam)).inverse() * l.p_w;
+      if (!rig_.model(ref.cam).project(p_c, uv)) continue;
+      const double e = (uv - Vec2(kp.x, kp.y)).norm() / sigmaOf(kp, options_.scale_factor);
+      if (e * e < 5.991 && map_.addObservation(lm, slot, ref.cam, ref.index)) touch(lm);
+    }
+  }
+}
+
+void LocalMapper::backendRemoveLandmark(int lm) {
+  Landmark& l = map_.landmark(lm);
+  if (solver_ && l.in_backend) solver_->removeLandmark(lm);
+  l.in_backend = false;
+}
+
+int LocalMapper::triangulateWithPrevious(int slot) {
+  Keyframe& kn = map_.keyframe(slot);
+  // Previous keyframes, newest first.
+  int previous[16];
+  int np = 0;
+  for (int want = 0; want < std::min(options_.temporal_keyframes, 16); ++want) {
+    int best = -1;
+    for (int i = 0; i < map_.keyframeCapacity(); ++i) {
+      const Keyframe& k = map_.keyframe(i);
+      if (!k.alive || k.id >= kn.id) continue;
+      bool taken = false;
+      for (int j = 0; j < np; ++j) taken = taken || previous[j] == i;
+      if (!taken && (best < 0 || k.id > map_.keyframe(best).id)) best = i;
+    }
+    if (best < 0) break;
+    previous[np++] = best;
+  }
+
+  const int cams = rig_.size();
+  const double min_depth = std::max(0.05, options_.new_points.min_depth);
+  constexpr double kMaxDepth = 200.0;
+  constexpr int kDepthSamples = 8;
+  constexpr int kMaxHamming = 50;    // stricter than tracking: nothing else vouches for these matches
+  constexpr float kRatio = 0.75f;
+  constexpr double kEpipolarPx = 2.0;
+  int created = 0;
+
+  for (int pi = 0; pi < np; ++pi) {
+    const int po = previous[pi];
+    const Keyframe& ko = map_.keyframe(po);
+    int nc = 0;
+    for (int c = 0; c < cams; ++c) std::fill(claim_.begin() + c * capacity_, claim_.begin() + c * capacity_ + ko.features.sets[c].count, -1);
+
+    for (int c2 = 0; c2 < cams; ++c2) {
+      if (!kn.features.present[c2]) continue;
+      const SE3 T_w_c2 = kn.T_w_b * rig_.T_b_c(c2);
+      const FeatureSet& set2 = kn.features.sets[c2];
+      for (int a = 0; a < set2.count; ++a) {
+        if (kn.landmark_of[c2][a] >= 0 || !kn.features.valid[c2][a]) continue;
+        const Vec3 d2 = T_w_c2.R * kn.features.bearings[c2][a];
+        const int oa = set2.keypoints[a].octave;
+        int best = 257, second = 257, best_c1 = -1, best_b = -1;
+        for (int c1 = 0; c1 < cams; ++c1) {
+          if (!ko.features.present[c1]) continue;
+          const SE3 T_w_c1 = ko.T_w_b * rig_.T_b_c(c1);
+          const double axes = std::acos(std::clamp(T_w_c1.R.col(2).dot(T_w_c2.R.col(2)), -1.0, 1.0));
+          if (axes > half_fov_[c1] + half_fov_[c2]) continue;  // the two views cannot share a point
+          const Vec3 baseline = T_w_c2.t - T_w_c1.t;
+          Vec3 n = baseline.cross(d2);
+          if (n.norm() < 1e-9) continue;  // no baseline, or the ray runs along it
+          n.normalize();
+          const SE3 T_c1_w = T_w_c1.inverse();
+          const CameraModel& m1 = rig_.model(c1);
+          const double f1 = 0.5 * (m1.fx() + m1.fy());
+          const FeatureSet& set1 = ko.features.sets[c1];
+          ++stamp_;
+          auto consider = [&](int b) {
+            uint32_t& v = visited_[static_cast<std::size_t>(c1) * capacity_ + b];
+            if (v == stamp_) return;
+            v = stamp_;
+            if (ko.landmark_of[c1][b] >= 0 || !ko.features.valid[c1][b]) return;
+            const int ob = set1.keypoints[b].octave;
+            if (std::abs(ob - oa) > 2) return;
+            const Vec3 d1 = T_w_c1.R * ko.features.bearings[c1][b];
+            if (std::abs(n.dot(d1)) > kEpipolarPx * std::pow(options_.scale_factor, ob) / f1) return;
+            const int d = hammingDistance(set2.descriptors[a], set1.descriptors[b]);
+            if (d < best) {
+              second = best;
+              best = d;
+              best_c1 = c1;
+              best_b = b;
+            } else if (d < second) {
+              second = d;
+            }
+          };
+          // Walk the epipolar curve of the ray over the depth range, cell by cell.
+          bool have_prev = false;
+          Vec2 prev;
+          for (int k = 0; k < kDepthSamples; ++k) {
+            const double inv = 1.0 / min_depth + (1.0 / kMaxDepth - 1.0 / min_depth) * k / (kDepthSamples - 1);
+            Vec2 uv;
+            if (!m1.project(T_c1_w * (T_w_c2.t + d2 / inv), uv) || !m1.inImage(uv, -40.0)) {
+              have_prev = false;
+              continue;
+            }
+            const Vec2 from = have_prev ? prev : uv;
+            const int steps = std::max(1, static_cast<int>((uv - from).norm() / 12.0));
+            for (int s = 0; s <= steps; ++s) {
+              const Vec2 q = from + (uv - from) * (static_cast<double>(s) / steps);
+              ko.grids[c1].forEachNear(q.x(), q.y(), 14.0, consider);
+            }
+            prev = uv;
+            have_prev = true;
+          }
+        }
+        if (best_b < 0 || best > kMaxHamming || !(best < kRatio * second)) continue;
+        // One candidate per old keypoint: the closest descriptor wins.
+        int32_t& claim = claim_[static_cast<std::size_t>(best_c1) * capacity_ + best_b];
+        if (claim >= 0) {
+          if (candidates_[claim].distance <= best) continue;
+          candidates_[claim].distance = -1;  // beaten
+        }
+        claim = nc;
+        candidates_[nc++] = Candidate{static_cast<int16_t>(c2), static_cast<int16_t>(best_c1), a, best_b,
+                                      static_cast<int16_t>(best)};
+      }
+    }
+
+    // Triangulate every surviving candidate from all its rays: both keypoints and their multi-view partners.
+    for (int i = 0; i < nc; ++i) {
+      const Candidate& cand = candidates_[i];
+      if (cand.distance < 0 || kn.landmark_of[cand.cam_new][cand.kp_new] >= 0) continue;
+      int n = 0;
+      auto addRays = [&](int kf_slot, int cam, int kp) {
+        const Keyframe& k = map_.keyframe(kf_slot);
+        const int mv = k.features.mv_of[cam][kp];
+        auto addOne = [&](int c, int idx) {
+          if (n >= static_cast<int>(tri_obs_.size()) || k.landmark_of[c][idx] >= 0) return;
+          TriangulationObservation& o = tri_obs_[n];
+          const Keypoint& key = k.features.sets[c].keypoints[idx];
+          o.model = &rig_.model(c);
+          o.T_f_c = k.T_w_b * rig_.T_b_c(c);
+          o.uv = Vec2(key.x, key.y);
+          o.bearing = k.features.bearings[c][idx];
+          o.sigma_px = sigmaOf(key, options_.scale_factor);
+          tri_refs_[n] = KeypointRef{static_cast<int16_t>(c), idx};
+          tri_kf_[n] = kf_slot;
+          ++n;
+        };
+        if (mv < 0) {
+          addOne(cam, kp);
+          return;
+        }
+        const MultiViewFeature& f = k.features.mv[mv];
+        for (int r = 0; r < f.size; ++r) addOne(k.features.mv_refs[f.first + r].cam, k.features.mv_refs[f.first + r].index);
+      };
+      addRays(slot, cand.cam_new, cand.kp_new);
+      addRays(po, cand.cam_old, cand.kp_old);
+      const TriangulationResult tri = triangulate(tri_obs_.data(), n, options_.new_points);
+      if (!tri.ok()) continue;
+      const int lm = map_.createLandmark(tri.point, kn.features.sets[cand.cam_new].descriptors[cand.kp_new], kn.id);
+      if (lm < 0) return created;
+      for (int r = 0; r < n; ++r) map_.addObservation(lm, tri_kf_[r], tri_refs_[r].cam, tri_refs_[r].index);
+      touch(lm);
+      ++created;
+    }
+  }
+  finishTouched();
+  return created;
+}
+
+bool LocalMapper::optimize(int slot) {
+  if (!solver_) return false;
+  const auto start = std::chrono::steady_clock::now();
+  Keyframe& kf = map_.keyframe(slot);
+  if (solver_->isFull()) {
+    const std::optional<int64_t> oldest = solver_->oldestKeyframe();
+    if (solver_->marginalizeOldest() != backend::Status::Ok) return false;
+    if (oldest) {
+      const int os = keyframeSlotOfId(*oldest);
+      if (os >= 0) map_.keyframe(os).in_backend = false;
+    }
+    for (const int64_t id : solver_->marginalizedLandmarks()) {
+      Landmark& l = map_.landmark(static_cast<int>(id));
+      l.in_backend = false;
+      l.frozen = true;
+    }
+  }
+  if (solver_->addKeyframe(kf.id, kf.T_w_b) != backend::Status::Ok) return false;
+  kf.in_backend = true;
+
+  for (int c = 0; c < kf.features.cameras(); ++c) {
+    for (int k = 0; k < kf.features.sets[c].count; ++k) {
+      const int lm = kf.landmark_of[c][k];
+      if (lm < 0) continue;
+      Landmark& l = map_.landmark(lm);
+      if (l.in_backend) {
+        const Keypoint& kp = kf.features.sets[c].keypoints[k];
+        solver_->addObservation(kf.id, lm, c, Vec2(kp.x, kp.y), sigmaOf(kp, options_.scale_factor));
+        continue;
+      }
+      if (l.frozen) continue;
+      int in_window = 0;
+      for (int o = 0; o < l.obs_count; ++o) in_window += map_.keyframe(l.obs[o].keyframe).in_backend ? 1 : 0;
+      if (in_window < 2 || solver_->addLandmark(lm, l.p_w) != backend::Status::Ok) continue;
+      l.in_backend = true;
+      for (int o = 0; o < l.obs_count; ++o) {
+        const Keyframe& ok = map_.keyframe(l.obs[o].keyframe);
+        if (!ok.in_backend) continue;
+        const Keypoint& kp = ok.features.sets[l.obs[o].cam].keypoints[l.obs[o].kp];
+        solver_->addObservation(ok.id, lm, l.obs[o].cam, Vec2(kp.x, kp.y), sigmaOf(kp, options_.scale_factor));
+      }
+    }
+  }
+
+  const backend::SolveSummary summary = solver_->solve(options_.backend_iterations);
+  ++backend_solves_;
+  // Outliers leave the back-end and the map (copied first: removing changes the solver's list).
+  int no = 0;
+  for (const backend::ObservationKey& o : solver_->outliers()) {
+    if (no < static_cast<int>(outliers_.size())) outliers_[no++] = o;
+  }
+  for (int i = 0; i < no; ++i) {
+    const backend::ObservationKey& o = outliers_[i];
+    const int lm = static_cast<int>(o.landmark_id);
+    const int ks = keyframeSlotOfId(o.keyframe_id);
+    solver_->removeObservation(o);
+    if (ks >= 0) map_.removeObservation(lm, ks, o.camera);
+    Landmark& l = map_.landmark(lm);
+    if (!l.alive) continue;
+    int in_window = 0;
+    for (int j = 0; j < l.obs_count; ++j) in_window += map_.keyframe(l.obs[j].keyframe).in_backend ? 1 : 0;
+    if (in_window < 2) backendRemoveLandmark(lm);
+    if (l.obs_count == 0) map_.eraseLandmark(lm);
+  }
+  if (!summary.failed) {
+    for (int i = 0; i < map_.keyframeCapacity(); ++i) {
+      Keyframe& k = map_.keyframe(i);
+      if (k.alive && k.in_backend) solver_->keyframePose(k.id, k.T_w_b);
+    }
+    map_.refreshLiveList();
+    for (int i = 0; i < map_.liveLandmarkCount(); ++i) {
+      Landmark& l = map_.landmark(map_.liveLandmarkSlots()[i]);
+      if (l.in_backend) solver_->landmarkPosition(map_.liveLandmarkSlots()[i], l.p_w);
+    }
+  }
+  last_backend_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return !summary.failed;
+}
+
+int LocalMapper::cull(int newest_slot) {
+  const int64_t newest_id = map_.keyframe(newest_slot).id;
+  map_.refreshLiveList();
+  int erased = 0;
+  for (int i = 0; i < map_.liveLandmarkCount(); ++i) {
+    const int lm = map_.liveLandmarkSlots()[i];
+    const Landmark& l = map_.landmark(lm);
+    if (!l.alive) continue;
+    const bool rarely_found = l.visible >= static_cast<uint32_t>(options_.cull_min_visible) &&
+                              l.found < options_.cull_min_found_ratio * l.visible;
+    const bool never_confirmed = !l.metric && l.created_keyframe_id <= newest_id - 3 && map_.observingKeyframes(lm) < 2;
+    if (l.obs_count == 0 || rarely_found || never_confirmed) {
+      backendRemoveLandmark(lm);
+      map_.eraseLandmark(lm);
+      ++erased;
+    }
+  }
+  return erased;
+}
+
+}  // namespace mcslam

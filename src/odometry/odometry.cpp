@@ -1,0 +1,351 @@
+#include "mcslam/odometry/odometry.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "mcslam/odometry/initializer.hpp"
+#include "mcslam/odometry/local_mapper.hpp"
+
+namespace mcslam {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+// Frames in a row that may fail before the map is dropped and built again.
+constexpr int kMaxLostFrames = 5;
+
+AbsolutePoseRansacOptions ransacOptions(const OdometryOptions& o) {
+  AbsolutePoseRansacOptions r;
+  r.min_inliers = o.min_tracked;
+  r.max_iterations = 300;
+  return r;
+}
+
+PoseRefinementOptions refinementOptions(const OdometryOptions& o) {
+  PoseRefinementOptions r;
+  r.min_inliers = o.min_tracked;
+  return r;
+}
+
+}  // namespace
+
+Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
+    : rig_(rig),
+      options_(options),
+      capacity_(max_features_per_camera),
+      map_(rig_, max_features_per_camera, options.max_keyframes, options.max_landmarks),
+      search_(rig_, max_features_per_camera),
+      ransac_(rig_, rig.size() * max_features_per_camera, ransacOptions(options)),
+      refiner_(rig_, rig.size() * max_features_per_camera, refinementOptions(options)) {
+  const int cams = rig_.size();
+  matches_.allocate(cams, max_features_per_camera, options.max_landmarks);
+  initializer_ = std::make_unique<Initializer>(rig_, options_, max_features_per_camera);
+  mapper_ = std::make_unique<LocalMapper>(rig_, options_, map_, max_features_per_camera);
+  observations_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
+  observation_refs_.resize(observations_.size());
+  last_tracked_.resize(options.max_landmarks);
+}
+
+Odometry::~Odometry() = default;
+
+Rig Odometry::refinedRig() const { return mapper_->refinedRig(); }
+
+void Odometry::resetMap() {
+  map_.clear();
+  mapper_->reset();
+  initializer_->reset();
+  last_tracked_count_ = 0;
+  have_velocity_ = false;
+}
+
+void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
+  const auto start = Clock::now();
+  timing_ = OdometryTiming{};
+  ++stats_.frames;
+  out = PoseEstimate{};
+  out.t = frame.t;
+  out.sequence = frame_index;
+
+  if (!initialized_) {
+    initialize(frame, frame_index, out);
+    timing_.tracking_ms = msSince(start) - timing_.mapping_ms - timing_.backend_ms;
+    return;
+  }
+
+  SE3 T_w_b;
+  int inliers = 0;
+  const TrackResult result = track(frame, frame_index, T_w_b, inliers);
+  if (result == TrackResult::Failed) {
+    ++stats_.lost;
+    ++lost_frames_;
+    // Carry on with the motion model so the trajectory stays continuous, and rebuild the map from
+    // there when the loss lasts.
+    T_w_last_ = have_velocity_ ? T_w_last_ * velocity_ : T_w_last_;
+    out.T_w_b = T_w_last_;
+    out.state = TrackingState::Lost;
+    out.valid = true;
+    if (lost_frames_ > kMaxLostFrames) {
+      anchor_ = T_w_last_;
+      initialized_ = false;
+      resetMap();
+    }
+    timing_.tracking_ms = msSince(start);
+    return;
+  }
+  lost_frames_ = 0;
+  ++stats_.tracking;
+  velocity_ = T_w_last_.inverse() * T_w_b;
+  have_velocity_ = true;
+  T_w_last_ = T_w_b;
+  timing_.tracking_ms = msSince(start);
+
+  if (needKeyframe(T_w_b, inliers, frame_index)) {
+    const auto map_start = Clock::now();
+    const int slot = mapper_->insertKeyframe(frame, &matches_, T_w_b, frame_index);
+    if (slot >= 0) {
+      mapper_->triangulateWithPrevious(slot);
+      timing_.mapping_ms = msSince(map_start);
+      const auto be_start = Clock::now();
+      mapper_->optimize(slot);
+      timing_.backend_ms = msSince(be_start);
+      const auto cull_start = Clock::now();
+      mapper_->cull(slot);
+      // The back-end moved this frame's pose: continue from there, with the same velocity.
+      T_w_last_ = map_.keyframe(slot).T_w_b;
+      last_keyframe_frame_ = frame_index;
+      last_keyframe_pose_ = T_w_last_;
+      last_keyframe_tracked_ = countKeyframeLandmarks(slot);
+      ++stats_.keyframes;
+      out.is_keyframe = true;
+      timing_.mapping_ms += msSince(cull_start);
+    }
+  }
+  rememberTracked(frame, frame_index);
+  out.T_w_b = T_w_last_;
+  out.state = TrackingState::Tracking;
+  out.valid = true;
+  out.quality = static_cast<float>(std::min(1.0, inliers / std::max(1.0, 0.5 * last_keyframe_tracked_)));
+}
+
+void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
+  out.T_w_b = anchor_;
+  out.state = TrackingState::NotInitialized;
+  int kf_new = -1;
+  last_init_reference_ = -1;
+  if (initializer_->oneFrameReady(frame)) {
+    // Enough metric multi-view features: the map starts from this frame alone.
+    resetMap();
+    kf_new = mapper_->insertKeyframe(frame, nullptr, anchor_, frame_index, true);
+    if (kf_new >= 0) mapper_->optimize(kf_new);
+  } else {
+    SE3 T_ref_cur;
+    if (initializer_->feed(frame, frame_index, T_ref_cur) == Initializer::TwoFrame::Ready) {
+      const auto map_start = Clock::now();
+      const FrameFeatures& ref = initializer_->reference();
+      const uint64_t ref_index = initializer_->referenceIndex();
+      map_.clear();
+      mapper_->reset();
+      const int kf_ref = mapper_->insertKeyframe(ref, nullptr, anchor_, ref_index, true);
+      kf_new = kf_ref >= 0 ? mapper_->insertKeyframe(frame, nullptr, anchor_ * T_ref_cur, frame_index, true) : -1;
+      const int created = kf_new >= 0 ? mapper_->triangulateWithPrevious(kf_new) : 0;
+      timing_.mapping_ms = msSince(map_start);
+      if (created < options_.init_min_matches / 2) {
+        // Too few points survive triangulation: keep the reference and wait for more motion.
+        map_.clear();
+        mapper_->reset();
+        kf_new = -1;
+      } else {
+        const auto be_start = Clock::now();
+        mapper_->optimize(kf_ref);
+        mapper_->optimize(kf_new);
+        timing_.backend_ms = msSince(be_start);
+        last_init_reference_ = static_cast<int64_t>(ref_index);
+      }
+    }
+  }
+  if (kf_new < 0) {
+    ++stats_.not_initialized;
+    return;
+  }
+  initializer_->reset();
+  initialized_ = true;
+  ++stats_.initializations;
+  ++stats_.keyframes;
+  T_w_last_ = map_.keyframe(kf_new).T_w_b;
+  have_velocity_ = false;
+  last_keyframe_frame_ = frame_index;
+  last_keyframe_pose_ = T_w_last_;
+  last_keyframe_tracked_ = countKeyframeLandmarks(kf_new);
+  // Track from the landmarks of the new keyframe.
+  last_tracked_count_ = 0;
+  const Keyframe& kf = map_.keyframe(kf_new);
+  for (int c = 0; c < kf.features.cameras(); ++c) {
+    for (int k = 0; k < kf.features.sets[c].count; ++k) {
+      const int lm = kf.landmark_of[c][k];
+      if (lm >= 0 && map_.landmark(lm).matched_frame != frame_index) {
+        map_.landmark(lm).matched_frame = frame_index;
+        last_tracked_[last_tracked_count_++] = lm;
+      }
+    }
+  }
+  ++stats_.tracking;
+  out.T_w_b = T_w_last_;
+  out.state = TrackingState::Tracking;
+  out.valid = true;
+  out.is_keyframe = true;
+  out.quality = 1.0f;
+}
+
+int Odometry::countKeyframeLandmarks(int slot) const {
+  const Keyframe& kf = map_.keyframe(slot);
+  int n = 0;
+  for (int c = 0; c < kf.features.cameras(); ++c) {
+    for (int k = 0; k < kf.features.sets[c].count; ++k) n += kf.landmark_of[c][k] >= 0 ? 1 : 0;
+  }
+  return n;
+}
+
+Odometry::TrackResult Odometry::track(const FrameFeatures& frame, uint64_t frame_index, SE3& T_w_b, int& inliers) {
+  const SE3 predicted = have_velocity_ ? T_w_last_ * velocity_ : T_w_last_;
+  search_.prepare(frame);
+  ProjectionSearchParams params;
+  params.max_hamming = options_.max_hamming;
+  params.ratio = options_.ratio;
+  params.scale_factor = options_.scale_factor;
+  params.levels = options_.levels;
+
+  // 1. The landmarks tracked in the previous frame, around the motion-model prediction; a wider
+  //    search over the whole local map when that finds too little (sudden turns, stops).
+  SE3 coarse = predicted;
+  inliers = 0;
+  for (int attempt = 0; attempt < 2 && inliers < options_.min_tracked; ++attempt) {
+    matches_.reset(frame);
+    params.radius_px = options_.track_radius_px * (attempt == 0 ? 1.0 : options_.wide_radius_factor);
+    map_.refreshLiveList();
+    const int32_t* slots = attempt == 0 ? last_tracked_.data() : map_.liveLandmarkSlots();
+    const int n = attempt == 0 ? last_tracked_count_ : map_.liveLandmarkCount();
+    if (search_.search(map_, slots, n, predicted, frame, params, matches_, false) >= options_.min_matches_for_pose) {
+      inliers = poseFromMatches(frame, predicted, true, coarse);
+    }
+  }
+  // 2. Recovery: match by descriptor alone to the landmarks of the newest keyframe, any camera.
+  if (inliers < options_.min_tracked) {
+    matches_.reset(frame);
+    const int newest = map_.newestKeyframe();
+    int n = 0;
+    if (newest >= 0) {
+      const Keyframe& kf = map_.keyframe(newest);
+      for (int c = 0; c < kf.features.cameras(); ++c) {
+        for (int k = 0; k < kf.features.sets[c].count; ++k) {
+          if (kf.landmark_of[c][k] >= 0) last_tracked_[n++] = kf.landmark_of[c][k];
+        }
+      }
+    }
+    last_tracked_count_ = 0;  // the list now holds keyframe landmarks, possibly repeated: not reusable
+    if (search_.searchByDescriptor(map_, last_tracked_.data(), n, frame, options_.max_hamming, 0.8f, matches_) >=
+        options_.min_matches_for_pose) {
+      inliers = poseFromMatches(frame, predicted, true, coarse);
+      if (inliers >= options_.min_tracked) ++stats_.recoveries;
+    }
+  }
+  if (inliers < options_.min_tracked) return TrackResult::Failed;
+
+  // 3. The local map, projected with the coarse pose into every camera, then the final refinement.
+  map_.refreshLiveList();
+  params.radius_px = options_.local_map_radius_px;
+  search_.search(map_, map_.liveLandmarkSlots(), map_.liveLandmarkCount(), coarse, frame, params, matches_, true);
+  const int refined = poseFromMatches(frame, coarse, false, T_w_b);
+  if (refined >= options_.min_tracked) {
+    inliers = refined;
+  } else {
+    T_w_b = coarse;
+  }
+  // Landmarks found in this frame.
+  for (int c = 0; c < frame.cameras(); ++c) {
+    for (int k = 0; k < frame.sets[c].count; ++k) {
+      const int lm = matches_.landmarkOf(c, k);
+      if (lm < 0) continue;
+      Landmark& l = map_.landmark(lm);
+      if (l.matched_frame != frame_index) {
+        l.matched_frame = frame_index;
+        ++l.found;
+      }
+    }
+  }
+  return TrackResult::Ok;
+}
+
+int Odometry::poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b) {
+  int n = 0;
+  for (int c = 0; c < frame.cameras(); ++c) {
+    for (int k = 0; k < frame.sets[c].count; ++k) {
+      const int lm = matches_.landmarkOf(c, k);
+      if (lm < 0 || !frame.valid[c][k]) continue;
+      const Keypoint& kp = frame.sets[c].keypoints[k];
+      PoseObservation& o = observations_[n];
+      o.camera = c;
+      o.pixel = Vec2(kp.x, kp.y);
+      o.ray = bodyRay(rig_, c, frame.bearings[c][k]);
+      o.point_w = map_.landmark(lm).p_w;
+      o.sigma_px = std::pow(options_.scale_factor, kp.octave);
+      observation_refs_[n] = KeypointRef{static_cast<int16_t>(c), k};
+      ++n;
+    }
+  }
+  if (n < options_.min_matches_for_pose) return 0;
+  const std::span<const PoseObservation> obs(observations_.data(), n);
+  std::span<const uint8_t> mask;
+  int inliers = 0;
+  if (use_ransac) {
+    const AbsolutePoseRansacResult r = ransac_.estimate(obs, &guess);
+    if (!r.ok()) return 0;
+    T_w_b = r.T_w_b;
+    mask = r.inlier_mask;
+    inliers = r.num_inliers;
+  } else {
+    const PoseRefinementResult r = refiner_.refine(obs, guess);
+    if (!r.success) return 0;
+    T_w_b = r.T_w_b;
+    mask = r.inlier_mask;
+    inliers = r.num_inliers;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!mask[i]) matches_.clear(observation_refs_[i].cam, observation_refs_[i].index);
+  }
+  return inliers;
+}
+
+bool Odometry::needKeyframe(const SE3& T_w_b, int inliers, uint64_t frame_index) const {
+  if (frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval)) return true;
+  if (inliers < options_.keyframe_tracked_ratio * last_keyframe_tracked_) return true;
+  const SE3 motion = last_keyframe_pose_.inverse() * T_w_b;
+  if (so3Log(motion.R).norm() * 180.0 / M_PI > options_.keyframe_rotation_deg) return true;
+  // Translation against the typical depth of what is tracked.
+  double depth_sum = 0;
+  int depth_n = 0;
+  for (int i = 0; i < last_tracked_count_ && depth_n < 200; ++i) {
+    depth_sum += (map_.landmark(last_tracked_[i]).p_w - T_w_b.t).norm();
+    ++depth_n;
+  }
+  const double depth = depth_n ? depth_sum / depth_n : 1.0;
+  return motion.t.norm() > options_.keyframe_translation_ratio * depth;
+}
+
+void Odometry::rememberTracked(const FrameFeatures& frame, uint64_t frame_index) {
+  last_tracked_count_ = 0;
+  for (int c = 0; c < frame.cameras(); ++c) {
+    for (int k = 0; k < frame.sets[c].count; ++k) {
+      const int lm = matches_.landmarkOf(c, k);
+      if (lm < 0) continue;
+      Landmark& l = map_.landmark(lm);
+      if (!l.alive || l.listed_frame == frame_index) continue;  // a landmark seen by several cameras: once
+      l.listed_frame = frame_index;
+      last_tracked_[last_tracked_count_++] = lm;
+    }
+  }
+}
+
+}  // namespace mcslam

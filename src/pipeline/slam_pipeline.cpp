@@ -1,0 +1,47 @@
+#include "mcslam/pipeline/slam_pipeline.hpp"
+
+#include <chrono>
+
+namespace mcslam {
+
+OdometryOptions effectiveOdometryOptions(const PipelineConfig& config, const OverlapMap& overlap) {
+  OdometryOptions o = config.odometry;
+  if (config.refine_extrinsics == "on") {
+    o.refine_extrinsics = true;
+  } else if (config.refine_extrinsics == "off") {
+    o.refine_extrinsics = false;
+  } else {
+    // A camera that overlaps no other could not be calibrated against a shared target: its extrinsic
+    // was chained (through an IMU) and deserves refinement.
+    bool isolated = false;
+    for (int i = 0; i < overlap.cameras() && overlap.cameras() > 1; ++i) {
+      bool any = false;
+      for (int j = 0; j < overlap.cameras(); ++j) any = any || overlap.overlaps(i, j) || overlap.overlaps(j, i);
+      isolated = isolated || !any;
+    }
+    o.refine_extrinsics = isolated;
+  }
+  return o;
+}
+
+SlamPipeline::SlamPipeline(const Rig& rig, const PipelineConfig& config)
+    : rig_(rig),
+      config_(config),
+      front_end_(rig_, config_),
+      odometry_(rig_, effectiveOdometryOptions(config_, front_end_.overlap()), config_.orb.max_features),
+      features_(rig_.size(), config_.orb.max_features) {}
+
+void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {
+  const auto start = std::chrono::steady_clock::now();
+  front_end_.compute(frame, features_);
+  odometry_.process(features_, frame.sequence, out);
+  out.t = frame.t;
+  const FrontEndTiming& f = front_end_.timing();
+  const OdometryTiming& o = odometry_.timing();
+  timing_.features_ms = f.extraction_ms + f.multiview_ms;
+  timing_.tracking_ms = o.tracking_ms + o.mapping_ms;
+  timing_.optimization_ms = o.backend_ms;
+  timing_.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace mcslam

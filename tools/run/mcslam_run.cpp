@@ -1,0 +1,141 @@
+// mcslam-run: runs the SLAM pipeline on a recorded dataset as fast as it can, and writes the trajectory of
+// every frame, the keyframes, per-stage timing and tracking statistics.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <future>
+#include <iostream>
+
+#include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/error.hpp"
+#include "mcslam/dataset/dataset.hpp"
+#include "mcslam/pipeline/slam_pipeline.hpp"
+#include "run_report.hpp"
+
+using namespace mcslam;
+
+namespace {
+
+// The `slam:` section of a config file; a file holding only the section's keys is accepted too.
+YAML::Node slamSection(const std::string& path) {
+  if (path.empty()) return YAML::Node();
+  YAML::Node root;
+  try {
+    root = YAML::Load(readTextFile(path));
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ": not valid YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (root.IsMap() && root["slam"]) return root["slam"];
+  return root;
+}
+
+struct LoadedFrame {
+  std::vector<Image> images;
+  std::vector<bool> present;
+  std::string error;
+};
+
+LoadedFrame loadFrame(const Dataset& ds, std::size_t i) {
+  LoadedFrame f;
+  f.images.resize(ds.rig().size());
+  ds.loadImages(i, f.images, f.present, &f.error);
+  return f;
+}
+
+void progress(std::size_t done, std::size_t total, double ms_per_frame, const PoseEstimate& pose) {
+  constexpr int kWidth = 32;
+  const int filled = total ? static_cast<int>(kWidth * done / total) : kWidth;
+  std::fprintf(stderr, "\r[%.*s%*s] %zu/%zu  %6.1f ms/frame  %-15s", filled, "################################",
+               kWidth - filled, "", done, total, ms_per_frame, trackingStateName(pose.state));
+  std::fflush(stderr);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
+  std::string dataset_dir, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
+  bool quiet = false;
+  app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
+      ->required();
+  app.add_option("--config", config_path, "YAML file with a `slam:` section (see config/slam.yaml); defaults otherwise");
+  app.add_option("--cameras", cameras_text, "Cameras of the rig to use, by calibration index, e.g. 0,1,2 (default: all)");
+  app.add_option("--out", out_path, "Trajectory of every frame, TUM format (pose of the body in the world)");
+  app.add_option("--keyframes", keyframes_path, "Keyframe poses, TUM format");
+  app.add_option("--stats", stats_path, "Timing per stage (mean, p99) and tracking states, JSON");
+  app.add_option("--extrinsics", extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
+  app.add_flag("--quiet", quiet, "No progress bar");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    DatasetOptions dopt;
+    if (!cameras_text.empty()) dopt.cameras = parseCameraList(cameras_text);
+    const Dataset ds = Dataset::open(dataset_dir, dopt);
+    for (const std::string& w : ds.warnings()) std::fprintf(stderr, "mcslam-run: warning: %s\n", w.c_str());
+    if (ds.size() == 0) throw InputError(dataset_dir + ": the dataset has no frames");
+    const PipelineConfig config = parsePipelineConfig(slamSection(config_path), config_path.empty() ? "defaults" : config_path,
+                                                      ds.rig());
+    SlamPipeline pipeline(ds.rig(), config);
+    run::RunReport report;
+    const bool show = !quiet && ::isatty(STDERR_FILENO);
+    if (!quiet) {
+      std::fprintf(stderr, "mcslam-run: %s (%s), %d camera%s, %zu frames\n", dataset_dir.c_str(), ds.format().c_str(),
+                   ds.rig().size(), ds.rig().size() == 1 ? "" : "s", ds.size());
+    }
+
+    const auto wall_start = std::chrono::steady_clock::now();
+    std::future<LoadedFrame> next = std::async(std::launch::async, loadFrame, std::cref(ds), std::size_t{0});
+    std::vector<ImageView> views(ds.rig().size());
+    std::unique_ptr<bool[]> present(new bool[ds.rig().size()]);
+    bool was_initialized = false;
+    double ms_avg = 0;
+    for (std::size_t i = 0; i < ds.size(); ++i) {
+      LoadedFrame frame = next.get();
+      if (i + 1 < ds.size()) next = std::async(std::launch::async, loadFrame, std::cref(ds), i + 1);  // decode ahead
+      if (!frame.error.empty()) std::fprintf(stderr, "%smcslam-run: frame %zu: %s\n", show ? "\n" : "", i, frame.error.c_str());
+      for (int c = 0; c < ds.rig().size(); ++c) {
+        present[c] = frame.present[c];
+        views[c] = frame.present[c] ? frame.images[c].view() : ImageView{};
+      }
+      RigFrameView view;
+      view.t = ds.frames()[i].t;
+      view.sequence = i;
+      view.cameras = ds.rig().size();
+      view.images = views.data();
+      view.present = present.get();
+      PoseEstimate pose;
+      pipeline.process(view, pose);
+      report.add(pose, pipeline.timing());
+      const bool initialized = pipeline.odometry().initialized();
+      if (initialized && !was_initialized && pipeline.odometry().lastInitializationReference() >= 0) {
+        report.backfill(static_cast<uint64_t>(pipeline.odometry().lastInitializationReference()), i);
+      }
+      was_initialized = initialized;
+      if (pose.is_keyframe) report.noteKeyframes(pipeline.odometry().map());
+      ms_avg = i == 0 ? pipeline.timing().total_ms : 0.95 * ms_avg + 0.05 * pipeline.timing().total_ms;
+      if (show && (i % 5 == 0 || i + 1 == ds.size())) progress(i + 1, ds.size(), ms_avg, pose);
+    }
+    report.noteKeyframes(pipeline.odometry().map());
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    if (show) std::fprintf(stderr, "\n");
+
+    if (!out_path.empty()) writeTumTrajectory(out_path, report.trajectory());
+    if (!keyframes_path.empty()) writeTumTrajectory(keyframes_path, report.keyframes());
+    if (!stats_path.empty()) report.writeStats(stats_path, pipeline, dataset_dir, ds.rig().size(), wall);
+    if (!extrinsics_path.empty()) writeKalibrRig(pipeline.refinedRig(), extrinsics_path);
+
+    const OdometryStats& s = pipeline.stats();
+    if (!quiet) {
+      std::fprintf(stderr, "mcslam-run: %llu frames in %.1f s: %llu tracked, %llu lost, %llu not initialized, %llu keyframes\n",
+                   static_cast<unsigned long long>(s.frames), wall, static_cast<unsigned long long>(s.tracking),
+                   static_cast<unsigned long long>(s.lost), static_cast<unsigned long long>(s.not_initialized),
+                   static_cast<unsigned long long>(s.keyframes));
+    }
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "mcslam-run: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,124 @@
+#include "run_report.hpp"
+
+#include <algorithm>
+#include <fstream>
+
+#include "mcslam/core/error.hpp"
+#include "mcslam/core/json_writer.hpp"
+
+namespace mcslam::run {
+
+void RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
+  FrameRecord r;
+  r.t = pose.t;
+  r.pose = pose;
+  r.timing = timing;
+  frames_.push_back(r);
+}
+
+void RunReport::backfill(uint64_t reference_index, uint64_t init_index) {
+  if (init_index >= frames_.size() || reference_index >= init_index) return;
+  const SE3 a = frames_[reference_index].pose.valid ? frames_[reference_index].pose.T_w_b : SE3();
+  const SE3 b = frames_[init_index].pose.T_w_b;
+  frames_[reference_index].pose.T_w_b = a;
+  frames_[reference_index].pose.valid = true;
+  const Vec6 xi = (a.inverse() * b).log();
+  for (uint64_t i = reference_index + 1; i < init_index; ++i) {
+    const double s = static_cast<double>(i - reference_index) / static_cast<double>(init_index - reference_index);
+    frames_[i].pose.T_w_b = a * SE3::exp(s * xi);
+    frames_[i].pose.valid = true;
+    frames_[i].interpolated = true;
+  }
+}
+
+void RunReport::noteKeyframes(const Map& map) {
+  for (int i = 0; i < map.keyframeCapacity(); ++i) {
+    const Keyframe& kf = map.keyframe(i);
+    if (kf.alive) keyframes_[kf.id] = StampedPose{kf.t, kf.T_w_b};
+  }
+}
+
+Trajectory RunReport::trajectory() const {
+  Trajectory out;
+  for (const FrameRecord& r : frames_) {
+    if (r.pose.valid) out.push_back(StampedPose{r.t, r.pose.T_w_b});
+  }
+  return out;
+}
+
+Trajectory RunReport::keyframes() const {
+  Trajectory out;
+  for (const auto& [id, p] : keyframes_) out.push_back(p);
+  std::sort(out.begin(), out.end(), [](const StampedPose& a, const StampedPose& b) { return a.t < b.t; });
+  return out;
+}
+
+namespace {
+
+struct Summary {
+  double mean = 0, p99 = 0, max = 0;
+};
+
+Summary summarize(std::vector<double> v) {
+  Summary s;
+  if (v.empty()) return s;
+  double sum = 0;
+  for (double x : v) sum += x;
+  s.mean = sum / v.size();
+  std::sort(v.begin(), v.end());
+  s.p99 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.99 * (v.size() - 1) + 0.5))];
+  s.max = v.back();
+  return s;
+}
+
+}  // namespace
+
+void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline, const std::string& dataset, int cameras,
+                           double wall_seconds) const {
+  std::ofstream out(path, std::ios::trunc);
+  if (!out) throw InputError(path + ": cannot write stats file");
+  std::vector<double> features, tracking, optimization, total;
+  uint64_t state_count[3] = {0, 0, 0};
+  int interpolated = 0;
+  for (const FrameRecord& r : frames_) {
+    features.push_back(r.timing.features_ms);
+    tracking.push_back(r.timing.tracking_ms);
+    optimization.push_back(r.timing.optimization_ms);
+    total.push_back(r.timing.total_ms);
+    ++state_count[static_cast<int>(r.pose.state)];
+    interpolated += r.interpolated ? 1 : 0;
+  }
+  const OdometryStats& s = pipeline.stats();
+  JsonWriter j(out);
+  j.beginObject();
+  j.key("dataset").value(dataset);
+  j.key("cameras").value(cameras);
+  j.key("frames").value(static_cast<unsigned long long>(frames_.size()));
+  j.key("wall_seconds").value(wall_seconds);
+  j.key("tracking_states").beginObject();
+  j.key("tracking").value(state_count[static_cast<int>(TrackingState::Tracking)]);
+  j.key("not_initialized").value(state_count[static_cast<int>(TrackingState::NotInitialized)]);
+  j.key("lost").value(state_count[static_cast<int>(TrackingState::Lost)]);
+  j.endObject();
+  j.key("interpolated_before_initialization").value(interpolated);
+  j.key("initializations").value(s.initializations);
+  j.key("keyframes").value(s.keyframes);
+  j.key("recoveries").value(s.recoveries);
+  j.key("rejected_images").value(pipeline.frontEnd().rejectedImages());
+  j.key("timing_ms").beginObject();
+  const std::pair<const char*, Summary> stages[] = {{"feature_extraction", summarize(features)},
+                                                    {"tracking_and_mapping", summarize(tracking)},
+                                                    {"optimization", summarize(optimization)},
+                                                    {"total", summarize(total)}};
+  for (const auto& [name, sum] : stages) {
+    j.key(name).beginObject();
+    j.key("mean").value(sum.mean);
+    j.key("p99").value(sum.p99);
+    j.key("max").value(sum.max);
+    j.endObject();
+  }
+  j.endObject();
+  j.endObject();
+}
+
+}  // namespace mcslam::run
