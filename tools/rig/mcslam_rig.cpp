@@ -8,6 +8,8 @@
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/json_writer.hpp"
+#include "mcslam/dataset/dataset.hpp"
+#include "overlap_report.hpp"
 
 using namespace mcslam;
 
@@ -63,8 +65,8 @@ void printInfoText(const Rig& rig, const std::string& path) {
     std::printf("  cam%d  pinhole/%-11s %4dx%-4d  f=(%.1f, %.1f) c=(%.1f, %.1f)  hfov %.1f deg\n", i,
                 distortionName(m.distortion()), m.width(), m.height(), m.fx(), m.fy(), m.cx(), m.cy(),
                 horizontalFovDeg(m));
-    std::printf("        position [%+.4f %+.4f %+.4f] m   looks along [%+.3f %+.3f %+.3f]\n", p.x(), p.y(), p.z(),
-                d.x(), d.y(), d.z());
+    std::printf("        position [%+.4f %+.4f %+.4f] m   looks along [%+.3f %+.3f %+.3f]\n", p.x() + 0.0, p.y() + 0.0,
+                p.z() + 0.0, d.x() + 0.0, d.y() + 0.0, d.z() + 0.0);
   }
   if (rig.size() > 1) {
     std::printf("baselines (m):\n      ");
@@ -81,18 +83,39 @@ void printInfoText(const Rig& rig, const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"mcslam-rig: inspect a multi-camera rig calibration (Kalibr camchain)"};
+  CLI::App app{"mcslam-rig: inspect a multi-camera rig calibration"};
   app.require_subcommand(1);
   std::string calib;
   bool json = false;
   auto* info = app.add_subcommand("info", "Cameras, models, resolutions, poses in the body frame and baselines");
-  info->add_option("CALIB", calib, "Kalibr camchain or imu-camchain YAML")->required();
+  info->add_option("CALIB", calib, "Kalibr camchain/imu-camchain YAML, EuRoC sensor.yaml, KITTI calib.txt or a dataset folder")
+      ->required();
   info->add_flag("--json", json, "Print JSON (keys: cameras[index, model, distortion, resolution, position, direction], baselines)");
+
+  OverlapOptions overlap;
+  std::string png_dir;
+  auto* ov = app.add_subcommand("overlap", "Overlap between camera pairs (paper eq. 1-2, full camera models, a depth range)");
+  ov->add_option("CALIB", calib, "Calibration (as for info)")->required();
+  ov->add_flag("--json", json, "Print JSON (keys: pairs[cameras, fraction], fraction_matrix)");
+  ov->add_option("--png", png_dir, "Write one picture of the cells per overlapping camera pair into this folder");
+  ov->add_option("--min-depth", overlap.min_depth, "Nearest scene depth, metres")->capture_default_str();
+  ov->add_option("--max-depth", overlap.max_depth, "Farthest scene depth, metres")->capture_default_str();
+  ov->add_option("--cell-size", overlap.cell_size_px, "Grid cell size, pixels")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
-    const Rig rig = loadKalibrRig(calib);
-    if (json) printInfoJson(rig);
-    else printInfoText(rig, calib);
+    const Rig rig = loadRigFromPath(calib);
+    if (info->parsed()) {
+      if (json) printInfoJson(rig);
+      else printInfoText(rig, calib);
+    } else {
+      const OverlapMap map(rig, overlap);
+      if (json) rigtool::printOverlapJson(rig, map);
+      else rigtool::printOverlapText(rig, map);
+      if (!png_dir.empty()) {
+        const int n = rigtool::writeOverlapPngs(rig, map, png_dir);
+        std::fprintf(stderr, "mcslam-rig: wrote %d picture%s to %s\n", n, n == 1 ? "" : "s", png_dir.c_str());
+      }
+    }
   } catch (const InputError& e) {
     std::fprintf(stderr, "mcslam-rig: %s\n", e.what());
     return 2;
