@@ -82,7 +82,8 @@ struct OrbExtractor::Impl {
   // a time), the smoothed level, the blur's intermediate and the FAST score map.
   std::vector<uint8_t> level_a, level_b, smoothed, blur_tmp, score_map;
   std::vector<int32_t> src_x;
-  std::vector<uint16_t> frac_x, resample_row;
+  std::vector<uint32_t> resample_weights;
+  std::vector<int16_t> resample_row;
   std::vector<Corner> corners;  // capacity fixed: local maxima of one level
   std::vector<int> per_cell;    // corners per fallback cell
   std::vector<Corner> chosen;
@@ -98,7 +99,7 @@ struct OrbExtractor::Impl {
     const size_t plane = static_cast<size_t>(w) * static_cast<size_t>(h) + kPadding;
     for (auto* buffer : {&level_a, &level_b, &smoothed, &blur_tmp, &score_map}) buffer->assign(plane, 0);
     src_x.resize(static_cast<size_t>(w) + 1);
-    frac_x.resize(static_cast<size_t>(w) + 1);
+    resample_weights.resize(static_cast<size_t>(w) + 1);
     resample_row.resize(static_cast<size_t>(w) + 1);
     corners.reserve(static_cast<size_t>(maxLocalMaxima(w, h)));
     per_cell.resize(static_cast<size_t>(Grid::maxCells(w, h, o.fallback_cell)));
@@ -210,7 +211,8 @@ OrbStatus OrbExtractor::extract(const ImageView& image, FeatureSet& out) {
       if (w <= 2 * s.options.edge_margin || h <= 2 * s.options.edge_margin) break;
       const Plane previous = current;
       current = Impl::plane(previous.data == s.level_a.data() ? s.level_b : s.level_a, w, h);
-      downscale(previous, current, s.options.scale_factor, {s.src_x.data(), s.frac_x.data(), s.resample_row.data()});
+      downscale(previous, current, s.options.scale_factor, {s.src_x.data(), s.resample_weights.data(), s.resample_row.data()},
+                s.options.use_simd);
     }
     const int budget = s.budgets[static_cast<size_t>(level)] + carry;
     carry = budget - s.extractLevel(level, current, budget, out);

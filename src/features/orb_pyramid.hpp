@@ -22,13 +22,14 @@ struct ConstPlane {
 // Scratch for downscale(): column tables and one intermediate row, each at least the source width.
 struct DownscaleScratch {
   int32_t* src_x;      // left source column of each destination column
-  uint16_t* frac_x;    // weight of the right column, 1/256 units
-  uint16_t* row;       // vertically interpolated source row
+  uint32_t* weights;   // its weights (left | right << 16), 1/256 units
+  int16_t* row;        // vertically interpolated source row (width + 1)
 };
 
 // Bilinear resampling where destination pixel x samples source (x + 0.5) * ratio - 0.5 (pixel centres
-// aligned, as the keypoint coordinates assume). dst.width/height say the destination size.
-void downscale(const ConstPlane& src, const Plane& dst, float ratio, const DownscaleScratch& scratch);
+// aligned, as the keypoint coordinates assume). dst.width/height say the destination size. Fixed point,
+// 8-bit weights; use_simd picks the SSE2 path where there is one (identical results).
+void downscale(const ConstPlane& src, const Plane& dst, float ratio, const DownscaleScratch& scratch, bool use_simd);
 
 // 7x7 Gaussian, sigma 2 (the smoothing rBRIEF's tests assume), borders replicated. tmp: src-sized.
 void gaussianBlur7(const ConstPlane& src, const Plane& dst, const Plane& tmp);
