@@ -45,7 +45,15 @@ AravisSource::AravisSource(const DaemonConfig& config)
     cam->layout = pixelLayoutFromName(cam->cfg.pixel_format);
     cam->width = config.rig.model(static_cast<int>(i)).width();
     cam->height = config.rig.model(static_cast<int>(i)).height();
-    open(*cam);
+    try {
+      open(*cam);
+    } catch (...) {
+      // Release what is open (a GigE camera keeps its control privilege for a previous owner until
+      // it is closed properly), then report.
+      close(*cam);
+      for (auto& opened : cameras_) close(*opened);
+      throw;
+    }
     cameras_.push_back(std::move(cam));
   }
 }
@@ -122,7 +130,6 @@ void AravisSource::open(Camera& cam) {
   check(err, key, "payload size");
   for (uint32_t i = 0; i < config_.aravis.stream_buffers; ++i)  // allocated once, pushed once
     arv_stream_push_buffer(cam.stream, arv_buffer_new(payload, nullptr));
-  cam.have_first_id = false;
 }
 
 void AravisSource::close(Camera& cam) {
@@ -237,24 +244,23 @@ void AravisSource::acquire(Camera& cam) {
     const auto* data = static_cast<const uint8_t*>(arv_buffer_get_data(buffer, &size));
     bool good = status == ARV_BUFFER_STATUS_SUCCESS && data;
     if (good) {
-      // Trigger index from the frame (block) ID, which GigE Vision 1.x wraps at 65535, skipping 0.
-      const uint64_t id = arv_buffer_get_frame_id(buffer);
-      if (!cam.have_first_id) {
-        cam.have_first_id = true;
-        cam.index_base = 0;
-      } else {
-        cam.index_base += id > cam.last_frame_id ? id - cam.last_frame_id : id + 0xFFFF - cam.last_frame_id;
-      }
-      cam.last_frame_id = id;
       CameraFrame& slot = rings_->slot(cam.index);
       good = convertToGrey(cam.layout, data, size, arv_buffer_get_image_width(buffer),
                            arv_buffer_get_image_height(buffer), slot.image);
       if (good) {
         const int64_t system_ns = static_cast<int64_t>(arv_buffer_get_system_timestamp(buffer));
         slot.capture_ns = system_ns > 0 ? system_ns : realtimeNowNs();
-        slot.trigger_index = triggered ? cam.index_base : cam.frames;
-        const int64_t trigger_mono = triggered ? triggers_->lookup(slot.trigger_index) : 0;
-        slot.trigger_mono_ns = trigger_mono ? trigger_mono : arrival;
+        // A triggered frame belongs to the newest trigger fired before it arrived: unlike counting
+        // frame IDs, this stays right after a camera missed a pulse. Free-running: the frame count.
+        uint64_t index = cam.frames;
+        int64_t fired = 0;
+        if (triggered && triggers_->latestAtOrBefore(arrival, index, fired)) {
+          slot.trigger_index = index;
+          slot.trigger_mono_ns = fired;
+        } else {
+          slot.trigger_index = cam.frames;
+          slot.trigger_mono_ns = arrival;
+        }
       }
     }
     arv_stream_push_buffer(cam.stream, buffer);  // back to the stream at once

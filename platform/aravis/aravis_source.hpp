@@ -43,8 +43,7 @@ class AravisSource final : public FrameSource, private TriggerOutput {
     ArvCamera* camera = nullptr;
     ArvStream* stream = nullptr;
     std::atomic<bool> lost{false};
-    bool have_first_id = false;
-    uint64_t last_frame_id = 0, index_base = 0, frames = 0;
+    uint64_t frames = 0;
     int64_t last_frame_mono = 0;
     ThreadAllocMeter meter;
     std::thread thread;

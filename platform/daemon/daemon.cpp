@@ -45,8 +45,8 @@ std::string trajectoryPathFor(const DaemonConfig& c) {
     const char* state = std::getenv("STATE_DIRECTORY");  // systemd: StateDirectory=, maybe colon-separated
     if (state && *state) dir = std::string(state).substr(0, std::string(state).find(':'));
   }
-  if (dir.empty()) dir = ".";
-  return (std::filesystem::path(dir) / c.output.trajectory).string();
+  const std::filesystem::path base = dir.empty() ? std::filesystem::current_path() : std::filesystem::path(dir);
+  return (base / c.output.trajectory).string();
 }
 
 Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> processor,
@@ -60,8 +60,7 @@ Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> proce
                  static_cast<int64_t>(config.assembly.tolerance_ms * kMs),
                  static_cast<int64_t>(config.assembly.timeout_ms * kMs)),
       rig_ring_(config.capacities.rig_ring_slots, [this](RigFrame& f) { f.allocate(sizes_); }),
-      pose_ring_(config.capacities.pose_ring_slots), views_(sizes_.size()), udp_(destinationsOf(config)),
-      trajectory_(trajectoryPathFor(config)) {
+      pose_ring_(config.capacities.pose_ring_slots), views_(sizes_.size()), udp_(destinationsOf(config)) {
   if (config.publish.shm_enabled)
     shm_ = std::make_unique<PoseShmWriter>(config.publish.shm_name, config.publish.shm_ring_length,
                                            config.publish.shm_mode);
@@ -75,6 +74,7 @@ Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> proce
     if (!out) throw InputError(config.file + ": trigger.mode: this source has no software trigger");
     trigger_thread_ = std::make_unique<TriggerThread>(*out, trigger_log_, t.rate_hz, config.realtime.trigger_priority);
   }
+  trajectory_ = std::make_unique<TrajectoryWriter>(trajectoryPathFor(config));
   if (config.realtime.lock_memory) {
     if (const std::string why = lockAllMemory(); !why.empty()) spdlog::warn("realtime.lock_memory: {}", why);
   }
@@ -113,7 +113,7 @@ bool Daemon::stop(int64_t grace_ns) {
   stop_publishing_ = true;
   pose_bell_.ring();
   publishing_thread_.join();
-  trajectory_.close();  // fsync
+  trajectory_->close();  // fsync
   if (shm_) shm_->markStopped();
   return processing_finished;
 }
@@ -206,7 +206,7 @@ void Daemon::publishPose(const PoseSlot& slot) {
   if (shm_) shm_->publish(r);
   udp_.send(r);
   if (slot.trigger_mono_ns > 0) latency_.record(monotonicNowNs() - slot.trigger_mono_ns);
-  if (r.valid()) trajectory_.append(r);
+  if (r.valid()) trajectory_->append(r);
   published_.store(r.sequence, std::memory_order_release);
 }
 
@@ -256,8 +256,8 @@ DaemonStats Daemon::stats() const {
   s.pose_drops = pose_drops_.load();
   s.udp_sent = udp_.sent();
   s.udp_failed = udp_.failed();
-  s.trajectory_poses = trajectory_.written();
-  s.trajectory_errors = trajectory_.errors();
+  s.trajectory_poses = trajectory_->written();
+  s.trajectory_errors = trajectory_->errors();
   s.tracking = static_cast<TrackingState>(tracking_.load());
   s.latency_count = latency_.count();
   s.latency_p50_ns = latency_.percentileNs(0.5);

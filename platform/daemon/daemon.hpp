@@ -62,7 +62,7 @@ class Daemon {
   bool drained() const;
   void health(char* out, std::size_t size) const { source_->health(out, size); }
   const DaemonConfig& config() const { return config_; }
-  std::string trajectoryPath() const { return trajectory_.path(); }
+  std::string trajectoryPath() const { return trajectory_->path(); }
 
  private:
   void assemblyLoop();
@@ -87,7 +87,7 @@ class Daemon {
 
   std::unique_ptr<PoseShmWriter> shm_;
   UdpPoseSender udp_;
-  TrajectoryWriter trajectory_;
+  std::unique_ptr<TrajectoryWriter> trajectory_;  // opened last: a failed start-up leaves files alone
 
   TriggerLog trigger_log_;
   std::unique_ptr<TriggerLine> gpio_line_;

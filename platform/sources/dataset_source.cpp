@@ -97,9 +97,12 @@ bool DatasetSource::waitTurn(std::size_t i, uint64_t loop, int64_t start_mono, u
     return false;
   }
   if (cfg_.rate == "fastest") {
-    // Lossless: at most two frames in flight (one processed, one waiting).
+    // Lossless: at most two frames in flight (one processed, one waiting). Should a frame vanish on
+    // the way (e.g. assembled together with another), go on after 2 s rather than wait forever.
+    const int64_t give_up = monotonicNowNs() + 2000000000;
     while (!stop_.load(std::memory_order_relaxed) &&
-           emitted_.load(std::memory_order_relaxed) >= processed_.load(std::memory_order_acquire) + 2) {
+           emitted_.load(std::memory_order_relaxed) >= processed_.load(std::memory_order_acquire) + 2 &&
+           monotonicNowNs() < give_up) {
       timespec ts{0, 200000};
       clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
     }
@@ -129,6 +132,7 @@ void DatasetSource::emit(std::size_t i, uint64_t loop, uint64_t trigger_index, i
   }
   const RigFrameEntry& entry = dataset_.frames()[i];
   const int64_t offset = static_cast<int64_t>(loop) * loop_period_ns_;
+  int delivered = 0;
   for (int c = 0; c < rings_->cameras(); ++c) {
     if (c >= static_cast<int>(present.size()) || !present[c]) continue;
     const auto [w, h] = rings_->size(c);
@@ -147,9 +151,10 @@ void DatasetSource::emit(std::size_t i, uint64_t loop, uint64_t trigger_index, i
     slot.trigger_index = trigger_index;
     slot.trigger_mono_ns = trigger_mono;
     rings_->publish(c);
+    ++delivered;
     counters_.frames.fetch_add(1, std::memory_order_relaxed);
   }
-  emitted_.fetch_add(1, std::memory_order_release);
+  if (delivered > 0) emitted_.fetch_add(1, std::memory_order_release);  // a frame without images never arrives
 }
 
 void DatasetSource::run() {

@@ -21,6 +21,21 @@ class TriggerLog {
   void record(uint64_t index, int64_t mono_ns) {
     entries_[index % kSize].index.store(index, std::memory_order_relaxed);
     entries_[index % kSize].mono_ns.store(mono_ns, std::memory_order_release);
+    count_.store(index + 1, std::memory_order_release);
+  }
+  // The newest trigger fired at or before `mono_ns` (a camera's frame belongs to it): false when none.
+  bool latestAtOrBefore(int64_t mono_ns, uint64_t& index, int64_t& fired_ns) const {
+    const uint64_t n = count_.load(std::memory_order_acquire);
+    for (uint64_t back = 0; back < n && back < 64; ++back) {
+      const uint64_t i = n - 1 - back;
+      const int64_t t = lookup(i);
+      if (t != 0 && t <= mono_ns) {
+        index = i;
+        fired_ns = t;
+        return true;
+      }
+    }
+    return false;
   }
   // 0 when that trigger is unknown or already overwritten.
   int64_t lookup(uint64_t index) const {
@@ -35,6 +50,7 @@ class TriggerLog {
     std::atomic<int64_t> mono_ns{0};
   };
   Entry entries_[kSize];
+  std::atomic<uint64_t> count_{0};
 };
 
 }  // namespace mcslam::platform

@@ -143,17 +143,24 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
     EXPECT_GT(s.camera_frames, 0u);
     EXPECT_EQ(s.bad_frames, 0u);
     EXPECT_EQ(s.allocations_after_warmup, 0u) << "over " << s.frames_after_warmup << " frames";
+    EXPECT_EQ(s.partial_frames, 0u);
     std::printf("fake camera: %llu triggers, %llu images, %llu processed, latency p50 %.2f ms p99 %.2f ms\n",
                 static_cast<unsigned long long>(s.triggers), static_cast<unsigned long long>(s.camera_frames),
                 static_cast<unsigned long long>(s.processed), s.latency_p50_ns * 1e-6, s.latency_p99_ns * 1e-6);
   }
 
-  // 3. A missing GPIO chip (the camera exists, so the GPIO is what fails) names trigger.gpio_chip.
-  const std::string gpio = test::writeFile(dir.file("gpio.yaml"),
-      aravisConfig(calib, "127.0.0.1",
-                   "trigger:\n  mode: gpio\n  rate_hz: 20\n  gpio_chip: gpiochip-mcslam-missing\n  gpio_line: 4\n"
-                   "output:\n  directory: " + dir.path().string() + "\n"));
+  // 3. Hardware trigger: an input line the camera does not have is refused naming the key; with a line
+  //    it has, the missing GPIO chip is what fails, naming trigger.gpio_chip.
+  const std::string gpio_trigger =
+      "trigger:\n  mode: gpio\n  rate_hz: 20\n  gpio_chip: gpiochip-mcslam-missing\n  gpio_line: 4\n"
+      "output:\n  directory: " + dir.path().string() + "\n";
   std::string out;
+  const std::string bad_line = test::writeFile(dir.file("line.yaml"), aravisConfig(calib, "127.0.0.1", gpio_trigger));
+  EXPECT_EQ(test::runCommand(test::binPath("mcslamd") + " --config " + bad_line, &out), 2) << out;
+  EXPECT_NE(out.find("source.aravis.cameras[0].trigger_line"), std::string::npos) << out;
+  std::string with_line = aravisConfig(calib, "127.0.0.1", gpio_trigger);
+  with_line.replace(with_line.find("pixel_format: Mono8}"), 20, "pixel_format: Mono8, trigger_line: Line0}");
+  const std::string gpio = test::writeFile(dir.file("gpio.yaml"), with_line);
   EXPECT_EQ(test::runCommand(test::binPath("mcslamd") + " --config " + gpio, &out), 2) << out;
   EXPECT_NE(out.find("trigger.gpio_chip"), std::string::npos) << out;
   EXPECT_NE(out.find("gpiochip-mcslam-missing"), std::string::npos) << out;

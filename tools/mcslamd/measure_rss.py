@@ -47,10 +47,11 @@ def make_dataset(root, frames=20, width=720, height=540, cameras=5):
             for f in range(frames):
                 t = 1000000000000 + f * 50000000
                 # Blocky random texture: cheap to make, has corners for a feature detector.
-                blocks = bytes(rng.randrange(256) for _ in range((width // 8) * (height // 8)))
+                bw, bh = (width + 7) // 8, (height + 7) // 8
+                blocks = bytes(rng.randrange(256) for _ in range(bw * bh))
                 rows = []
                 for y in range(height):
-                    row = bytes(blocks[(y // 8) * (width // 8) + x // 8] for x in range(width))
+                    row = bytes(blocks[(y // 8) * bw + x // 8] for x in range(width))
                     rows.append(row)
                 write_png(os.path.join(root, "cam%d" % c, "data", "%d.png" % t), width, height, b"".join(rows))
                 csv.write("%d,%d.png\n" % (t, t))

@@ -21,9 +21,9 @@ int main(int argc, char** argv) {
   long long count = 0;
   double wait_s = 10;
   bool latest = false;
-  app.add_option("--name", name, "Segment name (publish.shm.name)", true);
+  app.add_option("--name", name, "Segment name (publish.shm.name)")->capture_default_str();
   app.add_option("--count", count, "Exit after this many poses (0 = until the writer stops or Ctrl-C)");
-  app.add_option("--wait", wait_s, "Seconds to wait for the segment to appear", true);
+  app.add_option("--wait", wait_s, "Seconds to wait for the segment to appear")->capture_default_str();
   app.add_flag("--latest", latest, "Print only the latest pose once and exit");
   CLI11_PARSE(app, argc, argv);
   std::signal(SIGINT, onSignal);

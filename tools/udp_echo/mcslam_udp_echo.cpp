@@ -18,8 +18,8 @@ int main(int argc, char** argv) {
   int port = 9870;
   long long count = 0;
   double timeout_s = 0;
-  app.add_option("--bind", bind_address, "Local IPv4 address to listen on", true);
-  app.add_option("--port", port, "UDP port (publish.udp.destinations)", true);
+  app.add_option("--bind", bind_address, "Local IPv4 address to listen on")->capture_default_str();
+  app.add_option("--port", port, "UDP port (publish.udp.destinations)")->capture_default_str();
   app.add_option("--count", count, "Exit after this many poses (0 = forever)");
   app.add_option("--timeout", timeout_s, "Exit with status 1 when nothing arrives for this long (0 = wait forever)");
   CLI11_PARSE(app, argc, argv);
