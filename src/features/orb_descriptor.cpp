@@ -115,18 +115,29 @@ float intensityCentroidAngle(const uint8_t* center, int stride) {
   return angle;
 }
 
-void steeredBrief(const uint8_t* center, int stride, float angle, Descriptor& out) {
+PatternOffsets::PatternOffsets(int stride) : stride_(stride), offsets_(static_cast<size_t>(kAngleBins) * 2 * kTests) {
+  const RotatedPattern& pattern = rotatedPattern();
+  for (int bin = 0; bin < kAngleBins; ++bin) {
+    int32_t* out = offsets_.data() + static_cast<size_t>(bin) * 2 * kTests;
+    for (int i = 0; i < kTests; ++i) {
+      const PointPair& t = pattern.tests[bin][i];
+      out[2 * i] = t.ay * stride + t.ax;
+      out[2 * i + 1] = t.by * stride + t.bx;
+    }
+  }
+}
+
+const int32_t* PatternOffsets::forAngle(float angle) const {
   int bin = static_cast<int>(std::lround(angle * (kAngleBins / kTwoPi)));
   bin = ((bin % kAngleBins) + kAngleBins) % kAngleBins;
-  const PointPair* tests = rotatedPattern().tests[bin];
+  return offsets_.data() + static_cast<size_t>(bin) * 2 * kTests;
+}
+
+void steeredBrief(const uint8_t* center, const int32_t* offsets, Descriptor& out) {
   for (int word = 0; word < 4; ++word) {
     uint64_t bits = 0;
-    for (int i = 0; i < 64; ++i) {
-      const PointPair& t = tests[word * 64 + i];
-      const uint8_t a = center[t.ay * stride + t.ax];
-      const uint8_t b = center[t.by * stride + t.bx];
-      bits |= static_cast<uint64_t>(a < b) << i;
-    }
+    const int32_t* o = offsets + word * 128;
+    for (int i = 0; i < 64; ++i) bits |= static_cast<uint64_t>(center[o[2 * i]] < center[o[2 * i + 1]]) << i;
     out[word] = bits;
   }
 }

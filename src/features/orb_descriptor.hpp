@@ -1,6 +1,7 @@
 #pragma once
 // Orientation by intensity centroid and the steered BRIEF descriptor (rBRIEF) of one keypoint.
 #include <cstdint>
+#include <vector>
 
 #include "mcslam/features/keypoint.hpp"
 
@@ -31,7 +32,19 @@ void generateBriefPattern(PatternPoint (&a)[kTests], PatternPoint (&b)[kTests]);
 // around `center` (unsmoothed image). The disc must lie inside the image.
 float intensityCentroidAngle(const uint8_t* center, int stride);
 
-// Descriptor of the keypoint at `center` in the smoothed image, tests rotated by `angle`.
-void steeredBrief(const uint8_t* center, int stride, float angle, Descriptor& out);
+// The rotated pattern as address offsets for one row stride: two per test, for every angle bin.
+class PatternOffsets {
+ public:
+  explicit PatternOffsets(int stride);
+  int stride() const { return stride_; }
+  const int32_t* forAngle(float angle) const;  // 2 * kTests offsets
+
+ private:
+  int stride_;
+  std::vector<int32_t> offsets_;
+};
+
+// Descriptor of the keypoint at `center` in the smoothed image (its stride is the table's).
+void steeredBrief(const uint8_t* center, const int32_t* offsets, Descriptor& out);
 
 }  // namespace mcslam::orb_detail

@@ -78,7 +78,8 @@ struct OrbExtractor::Impl {
   int max_width, max_height;
   OrbLevelScales scales;
   std::vector<int> budgets;
-  // Planes as large as level 0: the current and previous pyramid levels (levels are processed one at
+  // Planes as large as level 0, all with the row stride of the largest image (so one table of pattern
+  // offsets serves every level): the current and previous pyramid levels (levels are processed one at
   // a time), the smoothed level, the blur's intermediate and the FAST score map.
   std::vector<uint8_t> level_a, level_b, smoothed, blur_tmp, score_map;
   std::vector<int32_t> src_x;
@@ -88,6 +89,7 @@ struct OrbExtractor::Impl {
   std::vector<int> per_cell;    // corners per fallback cell
   std::vector<Corner> chosen;
   SpacedSelector selector;
+  PatternOffsets pattern;
 
   Impl(const OrbOptions& o, int w, int h)
       : options(o),
@@ -95,7 +97,8 @@ struct OrbExtractor::Impl {
         max_height(h),
         scales(orbLevelScales(o)),
         budgets(levelBudgets(o)),
-        selector(maxLocalMaxima(w, h), w, h) {
+        selector(maxLocalMaxima(w, h), w, h),
+        pattern(std::max(w, 1)) {
     const size_t plane = static_cast<size_t>(w) * static_cast<size_t>(h) + kPadding;
     for (auto* buffer : {&level_a, &level_b, &smoothed, &blur_tmp, &score_map}) buffer->assign(plane, 0);
     src_x.resize(static_cast<size_t>(w) + 1);
@@ -104,10 +107,9 @@ struct OrbExtractor::Impl {
     corners.reserve(static_cast<size_t>(maxLocalMaxima(w, h)));
     per_cell.resize(static_cast<size_t>(Grid::maxCells(w, h, o.fallback_cell)));
     chosen.resize(static_cast<size_t>(o.max_features));
-    rotatedPattern();  // builds the shared pattern now rather than inside the first extract()
   }
 
-  static Plane plane(std::vector<uint8_t>& buffer, int w, int h) { return {buffer.data(), w, h, w}; }
+  Plane plane(std::vector<uint8_t>& buffer, int w, int h) const { return {buffer.data(), w, h, pattern.stride()}; }
 
   void scoreRect(const Plane& image, const Plane& scores, const Rect& r, int threshold) const;
   void detect(const Plane& image, const Rect& region);
@@ -173,7 +175,7 @@ int OrbExtractor::Impl::extractLevel(int level, const Plane& image, int budget, 
     kp.y = (c.y + 0.5f) * scale - 0.5f;
     kp.response = c.score;
     kp.octave = static_cast<int8_t>(level);
-    steeredBrief(smooth.data + offset, smooth.stride, kp.angle, out.descriptors[static_cast<size_t>(out.count)]);
+    steeredBrief(smooth.data + offset, pattern.forAngle(kp.angle), out.descriptors[static_cast<size_t>(out.count)]);
     ++out.count;
   }
   return n;
@@ -200,7 +202,7 @@ OrbStatus OrbExtractor::extract(const ImageView& image, FeatureSet& out) {
   if (image.empty()) return OrbStatus::kOk;
 
   // Level 0 is copied into our padded plane: the SIMD kernel may read past the caller's last row.
-  Plane current = Impl::plane(s.level_a, image.width, image.height);
+  Plane current = s.plane(s.level_a, image.width, image.height);
   for (int y = 0; y < image.height; ++y) std::memcpy(current.row(y), image.row(y), static_cast<size_t>(image.width));
 
   int carry = 0;  // budget a level could not use passes to the next one
@@ -210,7 +212,7 @@ OrbStatus OrbExtractor::extract(const ImageView& image, FeatureSet& out) {
       const int h = levelSize(image.height, s.scales.scale[static_cast<size_t>(level)]);
       if (w <= 2 * s.options.edge_margin || h <= 2 * s.options.edge_margin) break;
       const Plane previous = current;
-      current = Impl::plane(previous.data == s.level_a.data() ? s.level_b : s.level_a, w, h);
+      current = s.plane(previous.data == s.level_a.data() ? s.level_b : s.level_a, w, h);
       downscale(previous, current, s.options.scale_factor, {s.src_x.data(), s.resample_weights.data(), s.resample_row.data()},
                 s.options.use_simd);
     }
