@@ -1,5 +1,6 @@
 #include "mcslam/geometry/absolute_pose_ransac.hpp"
 
+#include <cmath>
 #include <limits>
 
 #include "mcslam/geometry/generalized_p3p.hpp"
@@ -43,12 +44,21 @@ double AbsolutePoseRansac::score(std::span<const PoseObservation> obs, const SE3
   const SE3 T_b_w = T_w_b.inverse();
   for (int c = 0; c < rig_.numCameras(); ++c) T_c_w_[c] = rig_.T_c_b(c) * T_b_w;
   const double cap = options_.chi2_threshold;
+  const double threshold_sigmas = std::sqrt(cap);
   double cost = 0;
   for (const PoseObservation& o : obs) {
     double s = cap;
-    Vec2 uv;
-    if (o.camera >= 0 && o.camera < rig_.numCameras() && rig_.model(o.camera).project(T_c_w_[o.camera] * o.point_w, uv)) {
-      s = std::min(cap, (uv - o.pixel).squaredNorm() / (o.sigma_px * o.sigma_px));
+    if (o.camera >= 0 && o.camera < rig_.numCameras()) {
+      // Cheap rejection first: a direction further from the keypoint's ray than the threshold
+      // allows in the worst corner of the lens cannot reproject within it (most points, for the
+      // many wrong hypotheses). cos(a) >= 1 - a^2 / 2 keeps the test conservative.
+      const Vec3 v = T_b_w * o.point_w - o.ray.origin;
+      const double max_angle = threshold_sigmas * o.sigma_px * rig_.maxRadiansPerPixel(o.camera);
+      const bool near_ray = max_angle >= 1.0 || v.dot(o.ray.direction) >= (1.0 - 0.5 * max_angle * max_angle) * v.norm();
+      Vec2 uv;
+      if (near_ray && rig_.model(o.camera).project(T_c_w_[o.camera] * o.point_w, uv)) {
+        s = std::min(cap, (uv - o.pixel).squaredNorm() / (o.sigma_px * o.sigma_px));
+      }
     }
     cost += s;
     if (cost >= bail_out) return cost;

@@ -31,12 +31,17 @@ Poly operator-(const Poly& a, const Poly& b) {
   for (int i = 0; i < 9; ++i) r.c[i] = a.c[i] - b.c[i];
   return r;
 }
+int topDegree(const Poly& a) {
+  int d = 8;
+  while (d > 0 && a.c[d] == 0) --d;
+  return d;
+}
 // Product truncated at degree 8; every product below stays within it by construction.
 Poly operator*(const Poly& a, const Poly& b) {
   Poly r;
-  for (int i = 0; i < 9; ++i) {
-    if (a.c[i] == 0) continue;
-    for (int j = 0; i + j < 9; ++j) r.c[i + j] += a.c[i] * b.c[j];
+  const int da = topDegree(a), db = topDegree(b);
+  for (int i = 0; i <= da; ++i) {
+    for (int j = 0; j <= db && i + j < 9; ++j) r.c[i + j] += a.c[i] * b.c[j];
   }
   return r;
 }

@@ -10,6 +10,9 @@ namespace {
 // |p(x)| below this fraction of sum |a_i x^i| is zero at double precision (with margin for the
 // rounding already in the coefficients).
 constexpr double kRelativeZero = 1e-10;
+// Roots are bracketed to this relative width: Newton converges quadratically well before, and
+// callers that need more polish the root on their own equations (the P3P does).
+constexpr double kRootTolerance = 1e-11;
 
 // Sum of |a_i| |x|^i: the scale against which p(x) is compared with zero.
 double magnitudeScale(const double* a, int n, double x) {
@@ -46,13 +49,15 @@ double rootInBracket(const double* a, int n, double lo, double hi, double p_lo) 
     if (!(next > lo && next < hi) || std::abs(next - x) > 0.5 * step_before) next = 0.5 * (lo + hi);
     step_before = std::abs(next - x);
     x = next;
-    if (hi - lo <= 4e-16 * std::max(1.0, std::abs(x)) || step_before <= 1e-16 * std::max(1.0, std::abs(x))) break;
+    if (hi - lo <= kRootTolerance * std::max(1.0, std::abs(x)) || step_before <= 0.01 * kRootTolerance * std::max(1.0, std::abs(x))) break;
   }
   return x;
 }
 
+// A (near) double root can be found twice, at a critical point and at a rounding-level sign change
+// beside it (they differ by about the square root of the rounding): keep one.
 void appendRoot(double x, double* roots, int& count) {
-  if (count > 0 && std::abs(x - roots[count - 1]) <= 1e-12 * std::max(1.0, std::abs(x))) return;
+  if (count > 0 && std::abs(x - roots[count - 1]) <= 1e-7 * std::max(1.0, std::abs(x))) return;
   roots[count++] = x;
 }
 
@@ -100,6 +105,19 @@ int realPolynomialRoots(const double* coeffs, int degree, double lo, double hi, 
   int n = std::min(degree, kMaxPolynomialDegree);
   while (n > 0 && coeffs[n] == 0) --n;
   if (n == 0 || !(lo <= hi)) return 0;
+  // Fujiwara's bound on the magnitude of every (complex) root; by Gauss-Lucas it holds for the
+  // roots of the derivatives too, so the whole recursion searches no wider than needed.
+  double bound = 0;
+  for (int k = 1; k <= n; ++k) {
+    const double ratio = std::abs(coeffs[n - k] / coeffs[n]) / (k == n ? 2.0 : 1.0);
+    bound = std::max(bound, std::pow(ratio, 1.0 / k));
+  }
+  bound *= 2.0;
+  if (std::isfinite(bound)) {
+    lo = std::max(lo, -bound);
+    hi = std::min(hi, bound);
+    if (!(lo <= hi)) return 0;
+  }
   return rootsOfTrimmed(coeffs, n, lo, hi, roots);
 }
 

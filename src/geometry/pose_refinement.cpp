@@ -77,28 +77,30 @@ PoseRefinementResult PoseRefiner::refine(std::span<const PoseObservation> obs, c
         H.noalias() += w * J.transpose() * J;
         g.noalias() += w * J.transpose() * r;
       }
-      // Levenberg-Marquardt: damp until the cost goes down.
-      bool improved = false;
-      Vec6 delta = Vec6::Zero();
-      while (lambda < 1e10) {
+      // Levenberg-Marquardt: damp until the cost goes down. A step too small to matter ends the
+      // round at once (each refused trial costs a full pass over the observations).
+      bool improved = false, converged = false;
+      for (int trial = 0; trial < 8 && !improved && !converged; ++trial) {
         Mat6 A = H;
         A.diagonal() += lambda * (H.diagonal().array() + 1e-12).matrix();
-        delta = A.ldlt().solve(-g);
-        ++result.iterations;
+        const Vec6 delta = A.ldlt().solve(-g);
         if (!delta.allFinite()) break;
+        converged = delta.norm() < 1e-9;
+        ++result.iterations;
         const SE3 candidate = T_w_b * SE3::exp(delta);
         const double candidate_cost = robustCost(obs, candidate.inverse(), robust);
         if (candidate_cost < cost) {
+          converged = converged || cost - candidate_cost < 1e-9 * cost;
           T_w_b = candidate;
           T_b_w = candidate.inverse();
           cost = candidate_cost;
           lambda = std::max(lambda * 0.2, 1e-9);
           improved = true;
-          break;
+        } else {
+          lambda *= 10.0;
         }
-        lambda *= 10.0;
       }
-      if (!improved || delta.norm() < 1e-10) break;
+      if (!improved || converged) break;
     }
     T_w_b.normalize();
     if (classify(obs, T_w_b.inverse()) < options_.min_inliers) break;

@@ -12,7 +12,7 @@ namespace mcslam {
 struct PoseObservation {
   int camera = 0;          // index of the camera in the rig
   Vec2 pixel = Vec2::Zero();  // measured keypoint, pixels
-  BodyRay ray;             // its ray in the body frame (bodyRay(rig, camera, unprojected bearing))
+  BodyRay ray;             // its ray in the body frame: bodyRay(rig, camera, unproject(pixel)), consistent with pixel
   Vec3 point_w = Vec3::Zero();  // the matched map point, world frame
   double sigma_px = 1.0;   // standard deviation of the keypoint (e.g. its pyramid scale), pixels
 };
@@ -27,6 +27,10 @@ class RigProjector {
   int numCameras() const { return static_cast<int>(models_.size()); }
   const CameraModel& model(int cam) const { return models_[cam]; }
   const SE3& T_c_b(int cam) const { return T_c_b_[cam]; }
+  // Largest angle one pixel spans anywhere in the image (with a margin): two directions more than
+  // n times this apart cannot project closer than n pixels, which lets RANSAC reject a point
+  // without the full projection.
+  double maxRadiansPerPixel(int cam) const { return max_rad_per_px_[cam]; }
 
   // Reprojection residual r = project(T_c_b * T_b_w * point_w) - pixel, in pixels. With J, also
   // dr/d(delta) for the body pose perturbed on the right, T_w_b * exp(delta), delta = [rho; phi].
@@ -37,6 +41,7 @@ class RigProjector {
  private:
   std::vector<CameraModel> models_;
   std::vector<SE3> T_c_b_;
+  std::vector<double> max_rad_per_px_;
 };
 
 }  // namespace mcslam
