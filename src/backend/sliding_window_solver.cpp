@@ -1,6 +1,9 @@
 #include "mcslam/backend/sliding_window_solver.hpp"
 
+#include <string>
+
 #include "marginalizer.hpp"
+#include "mcslam/core/error.hpp"
 #include "mcslam/backend/reprojection_residual.hpp"
 #include "reduced_system_solver.hpp"
 #include "window_linearization.hpp"
@@ -27,12 +30,31 @@ namespace {
 int countFreeExtrinsics(const Rig& rig, const SolverOptions& options) {
   return options.refine_extrinsics && rig.size() > 1 ? rig.size() - 1 : 0;
 }
+
+// Configuration errors surface at construction, never in the hot path.
+const Rig& validated(const Rig& rig, const WindowCapacity& cap, const SolverOptions& o) {
+  auto fail = [](const std::string& field, double value) {
+    throw InputError("SlidingWindowSolver: invalid " + field + " = " + std::to_string(value));
+  };
+  if (rig.size() < 1) fail("rig camera count", rig.size());
+  if (cap.max_keyframes < 1) fail("capacity.max_keyframes", cap.max_keyframes);
+  if (cap.max_landmarks < 1) fail("capacity.max_landmarks", cap.max_landmarks);
+  if (cap.max_observations < 1) fail("capacity.max_observations", cap.max_observations);
+  if (o.reference_camera < 0 || o.reference_camera >= rig.size()) fail("reference_camera", o.reference_camera);
+  if (!(o.loss.threshold > 0)) fail("loss.threshold", o.loss.threshold);
+  if (!(o.outlier_chi2 > 0)) fail("outlier_chi2", o.outlier_chi2);
+  if (!(o.extrinsic_prior.translation > 0)) fail("extrinsic_prior.translation", o.extrinsic_prior.translation);
+  if (!(o.extrinsic_prior.rotation > 0)) fail("extrinsic_prior.rotation", o.extrinsic_prior.rotation);
+  if (o.gauge_fixed_oldest < 0) fail("gauge_fixed_oldest", o.gauge_fixed_oldest);
+  if (!(o.initial_trust_radius > 0)) fail("initial_trust_radius", o.initial_trust_radius);
+  return rig;
+}
 }  // namespace
 
 struct SlidingWindowSolver::Impl {
   Impl(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& opts)
       : options(opts),
-        window(rig, capacity, opts),
+        window(validated(rig, capacity, opts), capacity, opts),
         prior(6 * countFreeExtrinsics(rig, opts)),
         linearization(window, opts),
         reduced(capacity.max_keyframes + rig.size()),

@@ -15,6 +15,21 @@ constexpr double kMinDiagonal = 1e-6;
 constexpr double kMaxDiagonal = 1e32;
 double clampDiagonal(double v) { return std::clamp(v, kMinDiagonal, kMaxDiagonal); }
 
+// Diagonal blocks of the reduced system are symmetric and only their upper triangle is read
+// (CHOLMOD takes the upper triangle), so only that half is accumulated.
+template <typename Block, typename Jac>
+void addUpperTransposeProduct(Block&& S, const Jac& J) {  // S += J^T J
+  for (int j = 0; j < 6; ++j) {
+    for (int i = 0; i <= j; ++i) S(i, j) += J.col(i).dot(J.col(j));
+  }
+}
+template <typename Block>
+void subtractUpperProduct(Block&& S, const Eigen::Matrix<double, 6, 3>& V, const Eigen::Matrix<double, 6, 3>& W) {
+  for (int j = 0; j < 6; ++j) {  // S -= V W^T
+    for (int i = 0; i <= j; ++i) S(i, j) -= V.row(i).dot(W.row(j));
+  }
+}
+
 // Smallest over largest eigenvalue of a landmark's 3x3 information: parallax.
 double conditioning(const Mat3& H) {
   Eigen::SelfAdjointEigenSolver<Mat3> es;
@@ -285,13 +300,13 @@ void WindowLinearization::buildReducedSystem(double mu, const MarginalizationPri
       const int pb = ref.pose_block, eb = ref.ext_block;
       if (pb >= 0) {
         W_[touch(pb)].noalias() += o.Jp.transpose() * o.Jl;
-        S_.block<6, 6>(6 * pb, 6 * pb).noalias() += o.Jp.transpose() * o.Jp;
+        addUpperTransposeProduct(S_.block<6, 6>(6 * pb, 6 * pb), o.Jp);
         g_c_.segment<6>(6 * pb).noalias() += o.Jp.transpose() * o.r;
         D_c_.segment<6>(6 * pb) += o.Jp.colwise().squaredNorm().transpose();
       }
       if (eb >= 0) {
         W_[touch(eb)].noalias() += o.Je.transpose() * o.Jl;
-        S_.block<6, 6>(6 * eb, 6 * eb).noalias() += o.Je.transpose() * o.Je;
+        addUpperTransposeProduct(S_.block<6, 6>(6 * eb, 6 * eb), o.Je);
         g_c_.segment<6>(6 * eb).noalias() += o.Je.transpose() * o.r;
         D_c_.segment<6>(6 * eb) += o.Je.colwise().squaredNorm().transpose();
       }
@@ -313,7 +328,11 @@ void WindowLinearization::buildReducedSystem(double mu, const MarginalizationPri
       for (int tb = 0; tb < num_touched; ++tb) {
         const int b = touched_[tb];
         if (a > b) continue;
-        S_.block<6, 6>(6 * a, 6 * b).noalias() -= V * W_[tb].transpose();
+        if (a == b) {
+          subtractUpperProduct(S_.block<6, 6>(6 * a, 6 * a), V, W_[tb]);
+        } else {
+          S_.block<6, 6>(6 * a, 6 * b).noalias() -= V * W_[tb].transpose();
+        }
         pattern_[size_t(a) * max_blocks_ + b] = 1;
       }
     }

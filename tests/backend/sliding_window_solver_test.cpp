@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "backend_testkit.hpp"
+#include "mcslam/core/error.hpp"
 
 using namespace mcslam;
 using namespace mcslam::backend;
@@ -244,4 +245,15 @@ TEST(SlidingWindowSolver, StatusCodes) {
   EXPECT_EQ(*solver.oldestKeyframe(), 2);
   EXPECT_EQ(solver.numKeyframes(), 1);
   EXPECT_FALSE(solver.isFull());
+}
+
+TEST(SlidingWindowSolver, BadConfigurationThrowsAtConstruction) {
+  const Rig rig = isecRig();
+  SolverOptions bad_reference;
+  bad_reference.reference_camera = 5;
+  EXPECT_THROW(SlidingWindowSolver(rig, {}, bad_reference), InputError);
+  EXPECT_THROW(SlidingWindowSolver(rig, {0, 10, 10}), InputError);
+  SolverOptions bad_sigma;
+  bad_sigma.extrinsic_prior.rotation = 0;
+  EXPECT_THROW(SlidingWindowSolver(rig, {}, bad_sigma), InputError);
 }

@@ -92,6 +92,7 @@ struct SolveSummary {
 
 class SlidingWindowSolver {
  public:
+  // Allocates everything the window will ever use. Throws InputError for a bad configuration.
   SlidingWindowSolver(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& options = {});
   ~SlidingWindowSolver();
   SlidingWindowSolver(const SlidingWindowSolver&) = delete;
@@ -111,7 +112,8 @@ class SlidingWindowSolver {
   // ---- optimization ----
   SolveSummary solve(int max_iterations);
   // Observations whose whitened squared residual exceeded outlier_chi2 (or that no longer
-  // project) after the last solve. Valid until the window changes.
+  // project) after the last solve. Valid until the next solve, addKeyframe, addLandmark or
+  // marginalizeOldest; calling removeObservation() while iterating over it is fine.
   std::span<const ObservationKey> outliers() const;
 
   // ---- marginalization ----
