@@ -1,7 +1,7 @@
 // Aravis for real: mcslamd acquires from Aravis's fake GigE Vision camera (arv-fake-gv-camera-0.8 on
 // 127.0.0.1, Debian package aravis-tools) in software-trigger mode, and frames flow through the whole
-// daemon to shared memory. Also: an unreachable camera and a missing GPIO chip end start-up with a
-// message naming the key. Only loopback addresses are ever contacted.
+// daemon to shared memory; a camera that disappears is reopened when it comes back. Also: an unreachable
+// camera, a trigger line the camera lacks and a missing GPIO chip end start-up with a message naming the key. Only loopback addresses are ever contacted.
 #include <arv.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -85,8 +85,8 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
   test::TempDir dir("fakecam");
   const std::string calib = dir.file("camchain.yaml");
   writeKalibrRig(test::smallRig(1, 320, 240), calib);  // the fake camera's region is set to this
-  FakeCamera camera;
-  ASSERT_TRUE(camera.waitReady()) << "the fake camera did not come up on 127.0.0.1";
+  auto camera = std::make_unique<FakeCamera>();
+  ASSERT_TRUE(camera->waitReady()) << "the fake camera did not come up on 127.0.0.1";
 
   // 1. The mcslamd process: software trigger at 20 Hz, poses appear in shared memory; SIGTERM stops it.
   const std::string shm = "/mcslam-test-fakecam-" + std::to_string(getpid());
@@ -149,7 +149,33 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
                 static_cast<unsigned long long>(s.processed), s.latency_p50_ns * 1e-6, s.latency_p99_ns * 1e-6);
   }
 
-  // 3. Hardware trigger: an input line the camera does not have is refused naming the key; with a line
+  // 3. A camera that disappears is reported lost and reopened; frames flow again once it is back,
+  //    while the daemon keeps running.
+  {
+    DaemonConfig c = parseDaemonConfig(
+        aravisConfig(calib, "127.0.0.1", "trigger:\n  mode: software\n  rate_hz: 20\n"
+                                         "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " +
+                                             dir.path().string() + "\n"),
+        dir.file("lost.yaml"));
+    c.aravis.frame_timeout_ms = 500;
+    Daemon d(c, createPipeline(c.slam, c.file, c.rig));
+    d.start();
+    auto waitUntil = [&](auto pred) {
+      const auto until = Clock::now() + std::chrono::seconds(60);  // liveness only
+      while (Clock::now() < until && !pred()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      return pred();
+    };
+    ASSERT_TRUE(waitUntil([&] { return d.stats().processed >= 10; }));
+    camera.reset();  // the camera goes away
+    ASSERT_TRUE(waitUntil([&] { return d.stats().lost_events >= 1; }));
+    const uint64_t before = d.stats().processed;
+    camera = std::make_unique<FakeCamera>();  // and comes back
+    EXPECT_TRUE(waitUntil([&] { return d.stats().processed >= before + 10; })) << "frames did not flow again";
+    d.stop();
+    EXPECT_GE(d.stats().lost_events, 1u);
+  }
+
+  // 4. Hardware trigger: an input line the camera does not have is refused naming the key; with a line
   //    it has, the missing GPIO chip is what fails, naming trigger.gpio_chip.
   const std::string gpio_trigger =
       "trigger:\n  mode: gpio\n  rate_hz: 20\n  gpio_chip: gpiochip-mcslam-missing\n  gpio_line: 4\n"
