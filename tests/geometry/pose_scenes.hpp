@@ -104,14 +104,7 @@ inline bool observe(const Rig& rig, int cam, const SE3& T_w_b, const Vec3& X_w, 
   Vec2 uv;
   if (!rig.model(cam).project(p_c, uv)) return false;
   uv += Vec2(r.gaussian(noise_px), r.gaussian(noise_px));
-  Vec3 bearing;
-  if (!rig.model(cam).unproject(uv, bearing)) return false;
-  obs.camera = cam;
-  obs.pixel = uv;
-  obs.ray = bodyRay(rig, cam, bearing);
-  obs.point_w = X_w;
-  obs.sigma_px = sigma_px;
-  return true;
+  return makePoseObservation(rig, cam, uv, X_w, sigma_px, obs);
 }
 
 struct PoseScene {

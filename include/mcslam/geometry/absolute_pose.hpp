@@ -17,6 +17,21 @@ struct PoseObservation {
   double sigma_px = 1.0;   // standard deviation of the keypoint (e.g. its pyramid scale), pixels
 };
 
+// The observation of keypoint `pixel` of camera `cam` (unit bearing_c = its unprojection, when the
+// caller has it already) matched to point_w.
+inline PoseObservation makePoseObservation(const Rig& rig, int cam, const Vec2& pixel, const Vec3& bearing_c,
+                                           const Vec3& point_w, double sigma_px) {
+  return {cam, pixel, bodyRay(rig, cam, bearing_c), point_w, sigma_px};
+}
+// Same, unprojecting the pixel; false when the pixel is outside the lens's valid domain.
+inline bool makePoseObservation(const Rig& rig, int cam, const Vec2& pixel, const Vec3& point_w, double sigma_px,
+                                PoseObservation& out) {
+  Vec3 bearing_c;
+  if (!rig.model(cam).unproject(pixel, bearing_c)) return false;
+  out = makePoseObservation(rig, cam, pixel, bearing_c, point_w, sigma_px);
+  return true;
+}
+
 // The cameras of a rig as the pose solvers need them. Copies the models and extrinsics once (the
 // only allocation); projecting allocates nothing.
 class RigProjector {
