@@ -23,7 +23,7 @@ bool ConfigSection::has(const char* key) const { return node_ && node_.IsMap() &
 
 YAML::Node ConfigSection::scalar(const char* key, const char* expected) {
   known_.emplace_back(key);
-  if (!has(key)) return {};
+  if (!has(key)) return YAML::Node(YAML::NodeType::Undefined);  // a default Node() is a *defined* null
   const YAML::Node n = node_[key];
   if (!n.IsScalar()) fail(key, std::string("must be ") + expected + ", got a " + (n.IsMap() ? "map" : "list"));
   return n;

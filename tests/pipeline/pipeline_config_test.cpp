@@ -1,0 +1,50 @@
+#include <gtest/gtest.h>
+
+#include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/error.hpp"
+#include "mcslam/pipeline/pipeline_config.hpp"
+#include "test_support.hpp"
+
+using namespace mcslam;
+
+namespace {
+Rig isec() { return loadKalibrRig(test::dataPath("calib/isec_5cam_camchain.yaml")); }
+
+std::string errorOf(const std::string& yaml) {
+  try {
+    parsePipelineConfig(YAML::Load(yaml), "run.yaml", isec());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(PipelineConfig, AbsentSectionGivesDefaults) {
+  const PipelineConfig c = parsePipelineConfig(YAML::Node(), "defaults", isec());
+  EXPECT_EQ(c.orb.max_features, 1000);
+  EXPECT_EQ(c.odometry.window_keyframes, OdometryOptions{}.window_keyframes);
+  EXPECT_NEAR(c.odometry.extrinsic_sigma_rotation_deg, 1.0, 1e-12);
+  const PipelineConfig partial = parsePipelineConfig(YAML::Load("capacity: {max_landmarks: 9000}"), "x.yaml", isec());
+  EXPECT_EQ(partial.odometry.max_landmarks, 9000);
+  EXPECT_EQ(partial.orb.max_features, 1000);  // untouched keys keep their defaults
+}
+
+TEST(PipelineConfig, EffectiveConfigReadsBackToTheSameValues) {
+  const PipelineConfig c = parsePipelineConfig(YAML::Load("features: {levels: 6}\ntracking: {radius_px: 22}"), "x.yaml", isec());
+  const YAML::Node back = YAML::Load(formatPipelineConfig(c));
+  const PipelineConfig d = parsePipelineConfig(back["slam"], "effective", isec());
+  EXPECT_EQ(d.orb.levels, 6);
+  EXPECT_DOUBLE_EQ(d.odometry.track_radius_px, 22);
+  EXPECT_EQ(formatPipelineConfig(d), formatPipelineConfig(c));
+}
+
+TEST(PipelineConfig, BadValuesNameFileAndKey) {
+  EXPECT_NE(errorOf("capacity: {max_featurs: 10}").find("run.yaml: slam.capacity.max_featurs: unknown key"), std::string::npos);
+  EXPECT_NE(errorOf("capacity: {max_features_per_camera: 0}").find("slam.capacity.max_features_per_camera"), std::string::npos);
+  EXPECT_NE(errorOf("tracking: {ratio: high}").find("slam.tracking.ratio"), std::string::npos);
+  EXPECT_NE(errorOf("backend: {refine_extrinsics: maybe}").find("auto, on, off"), std::string::npos);
+  EXPECT_NE(errorOf("features: [1, 2]").find("slam.features: must be a map"), std::string::npos);
+  EXPECT_NE(errorOf("capacity: {max_keyframes: 8, window_keyframes: 8}").find("max_keyframes"), std::string::npos);
+  EXPECT_NE(errorOf("multiview: {min_depth: 5, max_depth: 2}").find("max_depth"), std::string::npos);
+}
