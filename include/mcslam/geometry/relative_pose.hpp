@@ -5,7 +5,10 @@
 // minimal solvers (std::vector everywhere). Never call it on the per-frame path.
 //
 //  - Generalized (a rig of cameras with distinct centres): the 17-point linear solver (Li, Hartley,
-//    Kim 2008, OpenGV's seventeenpt) in RANSAC; the translation is METRIC.
+//    Kim 2008, OpenGV's seventeenpt) in RANSAC, re-solved on all its inliers; plus, when matches stay
+//    within cameras, a rotation-first hypothesis (5-point in the best-covered camera, then the scale
+//    most matches agree with), which is where the 17-point solver is weakest. The best refined
+//    hypothesis wins. The translation is METRIC.
 //  - Central (one camera): the 5-point solver (Nister, OpenGV's fivept_nister) in RANSAC; the
 //    translation has UNIT NORM (its scale is not observable) and the pose is that of the camera.
 // Both are then refined by Levenberg-Marquardt on the generalized epipolar error (eq. 4) divided
