@@ -15,21 +15,6 @@ constexpr double kMinDiagonal = 1e-6;
 constexpr double kMaxDiagonal = 1e32;
 double clampDiagonal(double v) { return std::clamp(v, kMinDiagonal, kMaxDiagonal); }
 
-// Diagonal blocks of the reduced system are symmetric and only their upper triangle is read
-// (CHOLMOD takes the upper triangle), so only that half is accumulated.
-template <typename Block, typename Jac>
-void addUpperTransposeProduct(Block&& S, const Jac& J) {  // S += J^T J
-  for (int j = 0; j < 6; ++j) {
-    for (int i = 0; i <= j; ++i) S(i, j) += J.col(i).dot(J.col(j));
-  }
-}
-template <typename Block>
-void subtractUpperProduct(Block&& S, const Eigen::Matrix<double, 6, 3>& V, const Eigen::Matrix<double, 6, 3>& W) {
-  for (int j = 0; j < 6; ++j) {  // S -= V W^T
-    for (int i = 0; i <= j; ++i) S(i, j) -= V.row(i).dot(W.row(j));
-  }
-}
-
 // Smallest over largest eigenvalue of a landmark's 3x3 information: parallax.
 double conditioning(const Mat3& H) {
   Eigen::SelfAdjointEigenSolver<Mat3> es;
@@ -177,10 +162,10 @@ void WindowLinearization::linearize(const WindowStorage& window, const Marginali
       landmark_cost += 0.5 * rho;
       const double sw = std::sqrt(weight);
       o.r = sw * r;
-      o.Jp = sw * J.pose;
-      o.Je = sw * J.extrinsic;
-      o.Jl = sw * J.point;
-      H.noalias() += o.Jl.transpose() * o.Jl;
+      o.Jp = sw * J.pose.transpose();
+      o.Je = sw * J.extrinsic.transpose();
+      o.Jl = sw * J.point.transpose();
+      H.noalias() += o.Jl * o.Jl.transpose();
       ++valid;
     }
     if (select_landmarks && (valid < 2 || conditioning(H) < options_.min_landmark_conditioning)) {
@@ -295,23 +280,23 @@ void WindowLinearization::buildReducedSystem(double mu, const MarginalizationPri
       const ObservationRef& ref = refs_[k];
       if (!ref.active) continue;
       const ObservationLin& o = lin_[k];
-      H.noalias() += o.Jl.transpose() * o.Jl;
-      g.noalias() += o.Jl.transpose() * o.r;
+      H.noalias() += o.Jl * o.Jl.transpose();
+      g.noalias() += o.Jl * o.r;
       const int pb = ref.pose_block, eb = ref.ext_block;
       if (pb >= 0) {
-        W_[touch(pb)].noalias() += o.Jp.transpose() * o.Jl;
-        addUpperTransposeProduct(S_.block<6, 6>(6 * pb, 6 * pb), o.Jp);
-        g_c_.segment<6>(6 * pb).noalias() += o.Jp.transpose() * o.r;
-        D_c_.segment<6>(6 * pb) += o.Jp.colwise().squaredNorm().transpose();
+        W_[touch(pb)].noalias() += o.Jp * o.Jl.transpose();
+        S_.block<6, 6>(6 * pb, 6 * pb).noalias() += o.Jp * o.Jp.transpose();
+        g_c_.segment<6>(6 * pb).noalias() += o.Jp * o.r;
+        D_c_.segment<6>(6 * pb) += o.Jp.rowwise().squaredNorm();
       }
       if (eb >= 0) {
-        W_[touch(eb)].noalias() += o.Je.transpose() * o.Jl;
-        addUpperTransposeProduct(S_.block<6, 6>(6 * eb, 6 * eb), o.Je);
-        g_c_.segment<6>(6 * eb).noalias() += o.Je.transpose() * o.r;
-        D_c_.segment<6>(6 * eb) += o.Je.colwise().squaredNorm().transpose();
+        W_[touch(eb)].noalias() += o.Je * o.Jl.transpose();
+        S_.block<6, 6>(6 * eb, 6 * eb).noalias() += o.Je * o.Je.transpose();
+        g_c_.segment<6>(6 * eb).noalias() += o.Je * o.r;
+        D_c_.segment<6>(6 * eb) += o.Je.rowwise().squaredNorm();
       }
       if (pb >= 0 && eb >= 0) {  // pose blocks come before extrinsic blocks
-        S_.block<6, 6>(6 * pb, 6 * eb).noalias() += o.Jp.transpose() * o.Je;
+        S_.block<6, 6>(6 * pb, 6 * eb).noalias() += o.Jp * o.Je.transpose();
         pattern_[size_t(pb) * max_blocks_ + eb] = 1;
       }
     }
@@ -328,11 +313,7 @@ void WindowLinearization::buildReducedSystem(double mu, const MarginalizationPri
       for (int tb = 0; tb < num_touched; ++tb) {
         const int b = touched_[tb];
         if (a > b) continue;
-        if (a == b) {
-          subtractUpperProduct(S_.block<6, 6>(6 * a, 6 * a), V, W_[tb]);
-        } else {
-          S_.block<6, 6>(6 * a, 6 * b).noalias() -= V * W_[tb].transpose();
-        }
+        S_.block<6, 6>(6 * a, 6 * b).noalias() -= V * W_[tb].transpose();
         pattern_[size_t(a) * max_blocks_ + b] = 1;
       }
     }
@@ -357,9 +338,9 @@ void WindowLinearization::backSubstitute() {
       if (!ref.active) continue;
       const ObservationLin& o = lin_[k];
       Vec2 v = Vec2::Zero();
-      if (ref.pose_block >= 0) v.noalias() += o.Jp * dx_c_.segment<6>(6 * ref.pose_block);
-      if (ref.ext_block >= 0) v.noalias() += o.Je * dx_c_.segment<6>(6 * ref.ext_block);
-      t.noalias() += o.Jl.transpose() * v;
+      if (ref.pose_block >= 0) v.noalias() += o.Jp.transpose() * dx_c_.segment<6>(6 * ref.pose_block);
+      if (ref.ext_block >= 0) v.noalias() += o.Je.transpose() * dx_c_.segment<6>(6 * ref.ext_block);
+      t.noalias() += o.Jl * v;
     }
     L.dx.noalias() = -L.H_inv * t;
   }

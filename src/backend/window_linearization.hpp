@@ -55,11 +55,13 @@ class WindowLinearization {
     int ext_block;   // -1: extrinsic not refined
     bool active;
   };
+  // Jacobians stored transposed (columns = residual rows), so that the J^T J and J^T J'
+  // products of the reduced system run on contiguous 6-vectors (SIMD-friendly).
   struct ObservationLin {
-    Vec2 r;    // sqrt(weight) * whitened residual
-    Mat26 Jp;  // sqrt(weight) * Jacobians
-    Mat26 Je;
-    Mat23 Jl;
+    Vec2 r;                          // sqrt(weight) * whitened residual
+    Eigen::Matrix<double, 6, 2> Jp;  // sqrt(weight) * (d r / d pose)^T
+    Eigen::Matrix<double, 6, 2> Je;  // ... extrinsic
+    Eigen::Matrix<double, 3, 2> Jl;  // ... landmark
   };
   struct LandmarkLin {
     int slot;
