@@ -61,6 +61,8 @@ struct SlidingWindowSolver::Impl {
         marginalizer(window, opts) {
     outliers.reserve(capacity.max_observations);
     marginalized.reserve(capacity.max_landmarks);
+    T_b_w.resize(capacity.max_keyframes);
+    T_c_b.resize(rig.size());
   }
 
   SolveSummary solve(int max_iterations);
@@ -74,6 +76,8 @@ struct SlidingWindowSolver::Impl {
   Marginalizer marginalizer;
   std::vector<ObservationKey> outliers;
   std::vector<int64_t> marginalized;
+  std::vector<SE3> T_b_w;  // outlier test scratch
+  std::vector<SE3> T_c_b;
 };
 
 SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
@@ -103,7 +107,7 @@ SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
       summary.converged = true;
       break;
     }
-    reduced.setStructure(lin.numBlocks(), lin.blockPattern());
+    if (lin.numBlocks() > 0) reduced.setStructure(lin.numBlocks(), lin.blockPattern());
     ++summary.iterations;
     const bool solved =
         lin.numBlocks() == 0 || reduced.solve(lin.reducedMatrix(), lin.reducedRhs(), lin.cameraStep());
@@ -155,14 +159,17 @@ SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
 
 void SlidingWindowSolver::Impl::classifyOutliers() {
   outliers.clear();
+  for (size_t s = 0; s < window.keyframes.size(); ++s) {
+    if (window.keyframes[s].used) T_b_w[s] = window.keyframes[s].T_w_b.inverse();
+  }
+  for (int c = 0; c < window.numCameras(); ++c) T_c_b[c] = window.extrinsics[c].T.inverse();
   for (const ObservationState& ob : window.observations) {
     if (!ob.used) continue;
     const KeyframeState& kf = window.keyframes[ob.keyframe];
     const LandmarkState& lm = window.landmarks[ob.landmark];
     Vec2 r;
-    const bool ok = reprojectionResidualInverse(window.rig().model(ob.camera), kf.T_w_b.inverse(),
-                                                window.extrinsics[ob.camera].T.inverse(), lm.p_w, ob.uv,
-                                                ob.inv_sigma, r, nullptr);
+    const bool ok = reprojectionResidualInverse(window.rig().model(ob.camera), T_b_w[ob.keyframe], T_c_b[ob.camera],
+                                                lm.p_w, ob.uv, ob.inv_sigma, r, nullptr);
     if (!ok || r.squaredNorm() > options.outlier_chi2) outliers.push_back({kf.id, lm.id, ob.camera});
   }
 }

@@ -257,3 +257,23 @@ TEST(SlidingWindowSolver, BadConfigurationThrowsAtConstruction) {
   bad_sigma.extrinsic_prior.rotation = 0;
   EXPECT_THROW(SlidingWindowSolver(rig, {}, bad_sigma), InputError);
 }
+
+TEST(SlidingWindowSolver, AllKeyframesFixedRefinesLandmarksOnly) {
+  // No free pose and no extrinsic: no reduced system at all, only the landmark steps.
+  SceneOptions so;
+  so.landmarks_per_keyframe = 30;
+  const Scene scene = makeScene(isecRig(), so);
+  WindowGuess guess = perturbedGuess(scene, 0.0, 0.0, 0.2, 9);
+  guess.T_w_b = scene.T_w_b;  // true poses
+  SolverOptions options;
+  options.gauge_fixed_oldest = 10;
+  SlidingWindowSolver solver(scene.rig, smallCapacity(), options);
+  fillSolver(solver, scene, guess);
+  const SolveSummary s = solver.solve(20);
+  EXPECT_TRUE(s.converged);
+  EXPECT_EQ(s.symbolic_analyses, 0);
+  EXPECT_LT(s.final_cost, 0.01 * s.initial_cost);
+  SE3 T;
+  solver.keyframePose(4, T);
+  EXPECT_EQ(T.t, scene.T_w_b[4].t);
+}
