@@ -1,0 +1,251 @@
+// Two passes per view, both parallel over tiles:
+//  1. visibility: per tile, the primitives whose bounds meet the tile's rays (BVH cone query, then the tile's
+//     bounding planes), sorted by distance; rays traced four at a time against them.
+//  2. shading: texture (mip level from the ray footprint) x baked irradiance. Pixels whose 8 neighbours do not
+//     all see the same face are anti-aliased by coverage: sub-pixel rays are traced and each face they hit is
+//     shaded once, weighted by its share of the samples.
+// Then the sensor model turns linear radiance into grey levels.
+#include "mcslam/sim/renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include "camera_lut.hpp"
+#include "frame_context.hpp"
+#include "packet_trace.hpp"
+#include "sensor_model.hpp"
+#include "thread_pool.hpp"
+
+namespace mcslam::sim {
+
+struct Renderer::Impl {
+  Impl(const RenderOptions& o, const detail::WorldData& world) : pool(o.threads), sensor(o.sensor, o.seed), ctx(world) {}
+
+  ThreadPool pool;
+  SensorModel sensor;
+  FrameContext ctx;
+  std::vector<std::shared_ptr<const CameraLut>> luts;
+  const CameraLut* lut = nullptr;
+  std::vector<uint32_t> key;  // per pixel: surface hit by the centre ray
+  std::vector<float> t;       // and its distance
+  std::vector<float> radiance;
+  std::vector<std::vector<Candidate>> tile_cands;
+  std::vector<float> samples;  // sub-pixel offsets, (x, y) pairs
+
+  void visibilityPass(int tile);
+  void shadingPass(int tile, float weight, bool accumulate, bool anti_aliasing);
+  float antiAliased(int x, int y, const std::vector<Candidate>& cands) const;
+  bool isEdge(int x, int y) const;
+};
+
+void Renderer::Impl::visibilityPass(int tile) {
+  std::vector<Candidate>& cands = tile_cands[tile];
+  ctx.collectCandidates(*lut, tile, cands);
+  const int W = lut->width, H = lut->height, ts = lut->tile;
+  const int tx = tile % lut->tiles_x, ty = tile / lut->tiles_x;
+  const int x0 = tx * ts, x1 = std::min(W, x0 + ts), y1 = std::min(H, (ty + 1) * ts);
+  const float* R = ctx.rotation();
+  int hint = -1;
+  for (int y = ty * ts; y < y1; ++y) {
+    for (int x = x0; x < x1; x += 4) {
+      // Gather up to four bearings and turn them into world directions.
+      f4 b[3] = {}, size = {};
+      RayPacket rays;
+      for (int l = 0; l < 4; ++l) {
+        const float* r = lut->ray(std::min(x + l, W - 1), y);
+        const bool real = x + l < x1 && r[3] > 0.f;
+        for (int k = 0; k < 3; ++k) b[k][l] = r[k];
+        size[l] = real ? 1.f : 0.f;
+      }
+      for (int k = 0; k < 3; ++k) rays.d[k] = R[3 * k] * b[0] + R[3 * k + 1] * b[1] + R[3 * k + 2] * b[2];
+      rays.active = size > 0.f;
+      uint32_t keys[4];
+      float ts4[4];
+      tracePacket(ctx, cands, rays, hint, keys, ts4);
+      for (int l = 0; l < 4 && x + l < x1; ++l) {
+        const std::size_t i = static_cast<std::size_t>(y) * W + x + l;
+        key[i] = keys[l];
+        t[i] = ts4[l];
+      }
+    }
+  }
+}
+
+bool Renderer::Impl::isEdge(int x, int y) const {
+  const int W = lut->width, H = lut->height;
+  const uint32_t k = key[static_cast<std::size_t>(y) * W + x];
+  for (int dy = -1; dy <= 1; ++dy) {
+    const int yy = y + dy;
+    if (yy < 0 || yy >= H) continue;
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int xx = x + dx;
+      if (xx < 0 || xx >= W) continue;
+      if (key[static_cast<std::size_t>(yy) * W + xx] != k && lut->valid(xx, yy)) return true;
+    }
+  }
+  return false;
+}
+
+// Coverage anti-aliasing: sub-pixel rays from the ray differentials of the neighbouring pixels.
+float Renderer::Impl::antiAliased(int x, int y, const std::vector<Candidate>& cands) const {
+  const int W = lut->width, H = lut->height;
+  const float* r = lut->ray(x, y);
+  const int xa = std::max(0, x - 1), xb = std::min(W - 1, x + 1);
+  const int ya = std::max(0, y - 1), yb = std::min(H - 1, y + 1);
+  const float *ra = lut->ray(xa, y), *rb = lut->ray(xb, y), *rc = lut->ray(x, ya), *rd = lut->ray(x, yb);
+  const bool okx = ra[3] > 0.f && rb[3] > 0.f, oky = rc[3] > 0.f && rd[3] > 0.f;
+  float gx[3], gy[3];
+  for (int c = 0; c < 3; ++c) {
+    gx[c] = okx ? (rb[c] - ra[c]) / static_cast<float>(xb - xa) : 0.f;
+    gy[c] = oky ? (rd[c] - rc[c]) / static_cast<float>(yb - ya) : 0.f;
+  }
+  const int n = static_cast<int>(samples.size() / 2);
+  const float* R = ctx.rotation();
+  uint32_t keys[64];
+  float dist[64], dirs[64][3];
+  int hint = -1;
+  for (int s0 = 0; s0 < n; s0 += 4) {
+    RayPacket rays;
+    f4 b[3];
+    for (int l = 0; l < 4; ++l) {
+      const int s = std::min(s0 + l, n - 1);
+      const float sx = samples[2 * s], sy = samples[2 * s + 1];
+      float v[3] = {r[0] + sx * gx[0] + sy * gy[0], r[1] + sx * gx[1] + sy * gy[1], r[2] + sx * gx[2] + sy * gy[2]};
+      const float inv = 1.f / std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (int k = 0; k < 3; ++k) b[k][l] = v[k] * inv;
+    }
+    for (int k = 0; k < 3; ++k) rays.d[k] = R[3 * k] * b[0] + R[3 * k + 1] * b[1] + R[3 * k + 2] * b[2];
+    rays.active = i4{-1, -1, -1, -1};
+    uint32_t k4[4];
+    float t4[4];
+    tracePacket(ctx, cands, rays, hint, k4, t4);
+    for (int l = 0; l < 4 && s0 + l < n; ++l) {
+      keys[s0 + l] = k4[l];
+      dist[s0 + l] = t4[l];
+      for (int k = 0; k < 3; ++k) dirs[s0 + l][k] = rays.d[k][l];
+    }
+  }
+  // Shade each distinct surface once (at its first sample), weighted by how many samples saw it.
+  float sum = 0.f;
+  bool done[64] = {};
+  for (int s = 0; s < n; ++s) {
+    if (done[s]) continue;
+    int count = 0;
+    for (int q = s; q < n; ++q) {
+      if (keys[q] == keys[s]) {
+        done[q] = true;
+        ++count;
+      }
+    }
+    const float value = keys[s] ? ctx.shade(keys[s], dist[s], dirs[s], r[3]) : ctx.sky(dirs[s]);
+    sum += value * static_cast<float>(count);
+  }
+  return sum / static_cast<float>(n);
+}
+
+void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool anti_aliasing) {
+  const std::vector<Candidate>& cands = tile_cands[tile];
+  const int W = lut->width, H = lut->height, ts = lut->tile;
+  const int tx = tile % lut->tiles_x, ty = tile / lut->tiles_x;
+  const int x1 = std::min(W, (tx + 1) * ts), y1 = std::min(H, (ty + 1) * ts);
+  for (int y = ty * ts; y < y1; ++y) {
+    for (int x = tx * ts; x < x1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      const float* r = lut->ray(x, y);
+      float value = 0.f;
+      if (r[3] > 0.f) {
+        if (anti_aliasing && isEdge(x, y)) {
+          value = antiAliased(x, y, cands);
+        } else {
+          float d[3];
+          ctx.rotate(r, d);
+          value = key[i] ? ctx.shade(key[i], t[i], d, r[3]) : ctx.sky(d);
+        }
+      }
+      radiance[i] = accumulate ? radiance[i] + weight * value : weight * value;
+    }
+  }
+}
+
+// ---- Renderer ----
+
+Renderer::Renderer(std::shared_ptr<const World> world, Rig rig, RenderOptions options)
+    : world_(std::move(world)), rig_(std::move(rig)), options_(options) {
+  if (!world_) throw std::invalid_argument("Renderer: no world");
+  options_.tile_size = std::clamp(options_.tile_size / 4 * 4, 4, 64);  // whole packets of four
+  options_.edge_samples = std::clamp(options_.edge_samples, 1, 64);
+  options_.sensor.motion_blur_samples = std::clamp(options_.sensor.motion_blur_samples | 1, 1, 63);
+  impl_ = std::make_unique<Impl>(options_, world_->data());
+  for (const RigCamera& c : rig_.cameras) impl_->luts.push_back(CameraLut::get(c.model, options_.tile_size, impl_->pool));
+  // N-rooks pattern: every column and every row of an n x n grid holds one sample.
+  const int n = options_.edge_samples;
+  int stride = n > 2 ? 3 : 1;
+  while (n > 2 && std::gcd(stride, n) != 1) ++stride;
+  for (int s = 0; s < n; ++s) {
+    impl_->samples.push_back((static_cast<float>(s) + 0.5f) / static_cast<float>(n) - 0.5f);
+    impl_->samples.push_back((static_cast<float>((s * stride) % n) + 0.5f) / static_cast<float>(n) - 0.5f);
+  }
+}
+
+Renderer::~Renderer() = default;
+
+double Renderer::exposureGain(int cam, double time_s) const {
+  return world_->exposure() * impl_->sensor.relativeGain(cam, time_s);
+}
+
+void Renderer::render(int cam, const SE3& T_w_b, double time_s, uint64_t frame_key, Image& image, DepthImage* depth) {
+  render(cam, [&T_w_b](double) { return T_w_b; }, time_s, frame_key, image, depth);
+}
+
+void Renderer::render(int cam, const std::function<SE3(double)>& T_w_b_at, double time_s, uint64_t frame_key,
+                      Image& image, DepthImage* depth) {
+  if (cam < 0 || cam >= rig_.size()) throw std::out_of_range("Renderer::render: no camera " + std::to_string(cam));
+  Impl& m = *impl_;
+  m.lut = m.luts[cam].get();
+  const int W = m.lut->width, H = m.lut->height;
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  m.key.resize(n);
+  m.t.resize(n);
+  m.radiance.resize(n);
+  m.tile_cands.resize(static_cast<std::size_t>(m.lut->tiles_x) * m.lut->tiles_y);
+  image.resize(W, H);
+  if (depth) depth->resize(W, H);
+
+  const double blur = std::max(0.0, options_.sensor.motion_blur_s);
+  const int subs = blur > 0 ? options_.sensor.motion_blur_samples : 1;
+  const int tiles = static_cast<int>(m.tile_cands.size());
+  for (int s = 0; s < subs; ++s) {
+    const double ts = subs == 1 ? time_s : time_s + blur * ((s + 0.5) / subs - 0.5);
+    m.ctx.setup(T_w_b_at(ts) * rig_.T_b_c(cam), ts);
+    m.pool.run(tiles, [&m](int tile) { m.visibilityPass(tile); });
+    if (depth && s == subs / 2) {
+      const bool range = options_.depth == DepthKind::Range;
+      m.pool.run(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * W + x;
+          depth->data[i] = m.key[i] ? (range ? m.t[i] : m.t[i] * m.lut->ray(x, y)[2]) : 0.f;
+        }
+      });
+    }
+    const float weight = 1.f / static_cast<float>(subs);
+    const bool aa = options_.anti_aliasing;
+    m.pool.run(tiles, [&m, weight, s, aa](int tile) { m.shadingPass(tile, weight, s > 0, aa); });
+  }
+
+  const float gain = static_cast<float>(exposureGain(cam, time_s));
+  const uint64_t stream = hashOf(options_.seed, frame_key, static_cast<uint64_t>(cam));
+  m.pool.run(H, [&](int y) {
+    uint8_t* row = image.row(y);
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      const float* r = m.lut->ray(x, y);
+      row[x] = r[3] > 0.f ? m.sensor.encode(m.radiance[i] * gain, m.sensor.vignette(r[2]), stream, static_cast<uint32_t>(i))
+                          : 0;
+    }
+  });
+}
+
+}  // namespace mcslam::sim

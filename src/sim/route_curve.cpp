@@ -1,0 +1,143 @@
+#include "route_curve.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "mcslam/core/error.hpp"
+
+namespace mcslam::sim {
+
+namespace {
+
+double wrapAngle(double a) {
+  while (a > M_PI) a -= 2 * M_PI;
+  while (a < -M_PI) a += 2 * M_PI;
+  return a;
+}
+
+}  // namespace
+
+RouteCurve::RouteCurve(const RouteSpec& spec, double smoothing, double step) : step_(step) {
+  const auto& P = spec.corners;
+  const int n = static_cast<int>(P.size());
+  if (n < 3) throw InputError("route: needs at least 3 corners, has " + std::to_string(n));
+  // Per corner: turn angle, tangent length of its fillet.
+  std::vector<double> turn(n), tangent(n), radius(n);
+  for (int i = 0; i < n; ++i) {
+    const Vec2 a = (P[i] - P[(i + n - 1) % n]).normalized(), b = (P[(i + 1) % n] - P[i]).normalized();
+    turn[i] = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+    radius[i] = i < static_cast<int>(spec.radii.size()) ? spec.radii[i] : 1.0;
+    tangent[i] = radius[i] * std::tan(std::abs(turn[i]) / 2);
+  }
+  for (int i = 0; i < n; ++i) {  // fillets must fit on their segments
+    const double seg = (P[(i + 1) % n] - P[i]).norm();
+    if (tangent[i] + tangent[(i + 1) % n] > seg + 1e-9) {
+      throw InputError("route: corner radii too large for the segment from corner " + std::to_string(i) + " to " +
+                       std::to_string((i + 1) % n));
+    }
+  }
+  // Piecewise-constant curvature, starting half-way along the segment from corner 0 to corner 1.
+  struct Piece {
+    double length, curvature;
+  };
+  std::vector<Piece> pieces;
+  std::vector<double> stop_at_piece;
+  double s = 0;
+  const double first_half = 0.5 * ((P[1] - P[0]).norm() - tangent[0] - tangent[1]);
+  pieces.push_back({first_half, 0.0});
+  s += first_half;
+  for (int k = 1; k <= n; ++k) {
+    const int i = k % n;
+    if (std::find(spec.stops.begin(), spec.stops.end(), i) != spec.stops.end()) stops_.push_back(s);
+    const double arc = radius[i] * std::abs(turn[i]);
+    pieces.push_back({arc, turn[i] / arc});
+    s += arc;
+    const double seg = (P[(i + 1) % n] - P[i]).norm() - tangent[i] - tangent[(i + 1) % n];
+    const double straight = k == n ? first_half : seg;
+    pieces.push_back({straight, 0.0});
+    s += straight;
+  }
+  length_ = s;
+  const int m = static_cast<int>(std::ceil(length_ / step_));
+  step_ = length_ / m;
+  std::vector<double> kappa(m, 0.0);
+  {
+    std::size_t pi = 0;
+    double start = 0;
+    for (int j = 0; j < m; ++j) {
+      const double sj = (j + 0.5) * step_;
+      while (pi + 1 < pieces.size() && sj > start + pieces[pi].length) start += pieces[pi++].length;
+      kappa[j] = pieces[pi].curvature;
+    }
+  }
+  // Periodic box smoothing of the curvature (keeps the total turn, so the heading still closes).
+  const int half = std::max(1, static_cast<int>(std::lround(0.5 * smoothing / step_)));
+  curvature_.assign(m, 0.0);
+  double acc = 0;
+  for (int j = -half; j <= half; ++j) acc += kappa[(j % m + m) % m];
+  for (int j = 0; j < m; ++j) {
+    curvature_[j] = acc / (2 * half + 1);
+    acc += kappa[(j + half + 1) % m] - kappa[((j - half) % m + m) % m];
+  }
+  // Integrate heading and position; spread the small position closure error linearly.
+  const Vec2 start_dir = (P[1] - P[0]).normalized();
+  const Vec2 start_point = P[0] + (tangent[0] + first_half) * start_dir;
+  double heading = std::atan2(start_dir.y(), start_dir.x());
+  points_.resize(m + 1);
+  heading_.resize(m + 1);
+  points_[0] = start_point;
+  heading_[0] = heading;
+  for (int j = 0; j < m; ++j) {
+    const double mid = heading + 0.5 * curvature_[j] * step_;
+    points_[j + 1] = points_[j] + step_ * Vec2(std::cos(mid), std::sin(mid));
+    heading += curvature_[j] * step_;
+    heading_[j + 1] = heading;
+  }
+  const Vec2 gap = points_[m] - points_[0];
+  for (int j = 0; j <= m; ++j) points_[j] -= gap * (static_cast<double>(j) / m);
+  curvature_.push_back(curvature_[0]);
+}
+
+void RouteCurve::at(double s, Vec2& p, double& heading, double& curvature) const {
+  s = std::fmod(s, length_);
+  if (s < 0) s += length_;
+  const double x = s / step_;
+  const int j = std::min(static_cast<int>(x), static_cast<int>(points_.size()) - 2);
+  const double f = x - j;
+  p = (1 - f) * points_[j] + f * points_[j + 1];
+  heading = heading_[j] + f * wrapAngle(heading_[j + 1] - heading_[j]);
+  curvature = (1 - f) * curvature_[j] + f * curvature_[j + 1];
+}
+
+double RouteCurve::distanceTo(const Vec2& q) const {
+  double best = 1e30;
+  for (std::size_t j = 0; j + 1 < points_.size(); ++j) {
+    const Vec2 a = points_[j], ab = points_[j + 1] - a;
+    const double f = std::clamp((q - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+    best = std::min(best, (a + f * ab - q).norm());
+  }
+  return best;
+}
+
+void checkRouteClearance(const World& world, const RouteCurve& curve, double clearance) {
+  const auto& pts = curve.points();
+  const int stride = std::max(1, static_cast<int>(0.05 / (curve.length() / (pts.size() - 1))));
+  for (std::size_t j = 0; j < pts.size(); j += stride) {
+    for (double z : {0.15, 0.6, 1.0, 1.5}) {
+      const Vec3 o(pts[j].x(), pts[j].y(), z);
+      for (int a = 0; a < 16; ++a) {
+        const double ang = 2 * M_PI * a / 16;
+        const Vec3 dir(std::cos(ang), std::sin(ang), 0);
+        if (auto hit = world.intersect(o, dir, clearance, 0.0, false)) {
+          char buf[200];
+          std::snprintf(buf, sizeof(buf), "route passes %.2f m from geometry at (%.2f, %.2f, %.2f) (needs %.2f m)",
+                        hit->t, o.x(), o.y(), z, clearance);
+          throw InputError(world.name() + ": " + buf);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace mcslam::sim
