@@ -285,7 +285,8 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
   MultiViewFeature& mv = f.mv[f.mv_count];
   mv.first = first;
   mv.size = static_cast<int16_t>(size);
-  mv.has_point = tri.status == TriangulationStatus::Ok;
+  mv.has_point = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain;
+  mv.metric = tri.status == TriangulationStatus::Ok;
   mv.p_b = tri.point;
   mv.relative_depth_sigma = static_cast<float>(tri.relative_depth_sigma);
   // Representative descriptor: the medoid (least total Hamming distance to the others).
@@ -309,6 +310,7 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
   f.mv_ref_count += size;
   ++stats_.tracks;
   stats_.tracks_with_point += mv.has_point ? 1 : 0;
+  stats_.metric_tracks += mv.metric ? 1 : 0;
 }
 
 }  // namespace mcslam

@@ -1,6 +1,8 @@
 #include "mcslam/odometry/initializer.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 
 namespace mcslam {
 
@@ -11,9 +13,9 @@ Initializer::Initializer(const Rig& rig, const OdometryOptions& options, int max
   best_of_ref_.resize(max_features_per_camera);
 }
 
-int Initializer::metricMultiView(const FrameFeatures& f) {
+int Initializer::usableMultiView(const FrameFeatures& f, double max_depth_sigma) {
   int n = 0;
-  for (int t = 0; t < f.mv_count; ++t) n += f.mv[t].has_point ? 1 : 0;
+  for (int t = 0; t < f.mv_count; ++t) n += f.mv[t].has_point && f.mv[t].relative_depth_sigma <= max_depth_sigma ? 1 : 0;
   return n;
 }
 
@@ -97,6 +99,7 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
     r = estimateGeneralizedRelativePose(rig_, correspondences_, ro);
   }
   last_status_ = r.status;
+  if (std::getenv("MCSLAM_DEBUG_INIT")) std::fprintf(stderr, "init frame %llu ref %llu matches %d status %s inliers %d iters %d scale_sigma %.3f parallax %.4f t %.3f\n", (unsigned long long)frame_index, (unsigned long long)reference_index_, last_matches_, relativePoseStatusName(r.status), r.num_inliers, r.ransac_iterations, r.relative_scale_sigma, r.median_parallax_rad, r.T_1_2.t.norm());
   if (!r.ok()) return TwoFrame::Waiting;
   if (rig_.size() == 1) {
     // The central solver works in camera frames: bring the motion into the body frame.

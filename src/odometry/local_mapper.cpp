@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace mcslam {
 
@@ -146,7 +148,7 @@ int LocalMapper::insertKeyframe(const FrameFeatures& frame, const FrameMatches* 
   if (create_multiview_points) {
     for (int t = 0; t < frame.mv_count; ++t) {
       const MultiViewFeature& mv = frame.mv[t];
-      if (!mv.has_point) continue;
+      if (!mv.has_point || mv.relative_depth_sigma > options_.landmark_max_depth_sigma) continue;
       bool linked = false;
       for (int r = 0; r < mv.size && !linked; ++r) {
         const KeypointRef& ref = frame.mv_refs[mv.first + r];
@@ -302,6 +304,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
           candidates_[claim].distance = -1;  // beaten
         }
         claim = nc;
+        ++debug_candidates_;
         candidates_[nc++] = Candidate{static_cast<int16_t>(c2), static_cast<int16_t>(best_c1), a, best_b,
                                       static_cast<int16_t>(best)};
       }
@@ -338,6 +341,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
       addRays(slot, cand.cam_new, cand.kp_new);
       addRays(po, cand.cam_old, cand.kp_old);
       const TriangulationResult tri = triangulate(tri_obs_.data(), n, options_.new_points);
+      if (std::getenv("MCSLAM_DEBUG_MAPPING")) ++debug_status_[static_cast<int>(tri.status)];
       if (!tri.ok()) continue;
       const int lm = map_.createLandmark(tri.point, kn.features.sets[cand.cam_new].descriptors[cand.kp_new], kn.id);
       if (lm < 0) return created;
@@ -347,6 +351,13 @@ int LocalMapper::triangulateWithPrevious(int slot) {
     }
   }
   finishTouched();
+  if (std::getenv("MCSLAM_DEBUG_MAPPING")) {
+    std::fprintf(stderr, "triangulate kf %lld: candidates %d created %d status", (long long)kn.id, debug_candidates_, created);
+    for (int i = 0; i < 7; ++i) std::fprintf(stderr, " %s=%d", triangulationStatusName(static_cast<TriangulationStatus>(i)), debug_status_[i]);
+    std::fprintf(stderr, "\n");
+    for (int& d : debug_status_) d = 0;
+    debug_candidates_ = 0;
+  }
   return created;
 }
 

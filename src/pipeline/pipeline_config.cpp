@@ -37,7 +37,8 @@ void readMultiView(ConfigSection s, PipelineConfig& c) {
   s.read("max_hamming", c.multiview.max_hamming, 1, 256);
   s.read("ratio", c.multiview.ratio, 0.1, 1.0);
   s.read("epipolar_px", c.multiview.epipolar_px, 0.1, 50.0);
-  s.read("max_relative_depth_sigma", c.multiview.triangulation.max_relative_depth_sigma, 1e-4, 1.0);
+  s.read("metric_depth_sigma", c.multiview.triangulation.max_relative_depth_sigma, 1e-4, 1.0);
+  s.read("landmark_depth_sigma", c.odometry.landmark_max_depth_sigma, 1e-4, 1.0);
   s.finish();
   if (c.overlap.max_depth <= c.overlap.min_depth) s.fail("max_depth", "must be larger than min_depth");
 }
@@ -126,7 +127,8 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    max_hamming: " << c.multiview.max_hamming << "\n"
      << "    ratio: " << c.multiview.ratio << "\n"
      << "    epipolar_px: " << c.multiview.epipolar_px << "\n"
-     << "    max_relative_depth_sigma: " << c.multiview.triangulation.max_relative_depth_sigma << "\n"
+     << "    metric_depth_sigma: " << c.multiview.triangulation.max_relative_depth_sigma << "\n"
+     << "    landmark_depth_sigma: " << o.landmark_max_depth_sigma << "\n"
      << "  tracking:\n"
      << "    max_hamming: " << o.max_hamming << "\n"
      << "    ratio: " << o.ratio << "\n"

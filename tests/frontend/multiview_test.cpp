@@ -104,7 +104,7 @@ TEST(MultiViewMatcher, FindsTheTrueTracksWithMetricDepth) {
     }
     pure += same ? 1 : 0;
     if (same) found[p0] = 1;
-    if (mv.has_point) {
+    if (mv.metric) {
       ++with_point;
       if (same) {
         const Vec3 truth = s.scene[p0].p_b;

@@ -41,6 +41,7 @@ void printJson(const FrameFeatures& f, std::size_t frame) {
     }
     j.endArray();
     j.key("has_point").value(mv.has_point);
+    j.key("metric").value(mv.metric);
     j.key("point_body").vector(mv.p_b, 3);
     j.key("relative_depth_sigma").value(static_cast<double>(mv.relative_depth_sigma));
     j.endObject();
@@ -95,10 +96,10 @@ int main(int argc, char** argv) {
     if (json) {
       printJson(features, frame);
     } else {
-      int with_point = 0;
-      for (int t = 0; t < features.mv_count; ++t) with_point += features.mv[t].has_point ? 1 : 0;
-      std::printf("frame %zu: %d keypoints in %d cameras, %d multi-view features (%d with a metric point), %d mono\n",
-                  frame, features.keypointCount(), ds.rig().size(), features.mv_count, with_point, features.monoCount());
+      const MultiViewStats& s = front.multiViewStats();
+      std::printf("frame %zu: %d keypoints in %d cameras, %d multi-view features (%d with a point, %d metric), %d mono\n",
+                  frame, features.keypointCount(), ds.rig().size(), features.mv_count, s.tracks_with_point,
+                  s.metric_tracks, features.monoCount());
       std::printf("front-end: extraction %.1f ms, multi-view %.1f ms\n", front.timing().extraction_ms,
                   front.timing().multiview_ms);
     }

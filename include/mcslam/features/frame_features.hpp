@@ -21,9 +21,10 @@ struct KeypointRef {
 struct MultiViewFeature {
   int32_t first = 0;          // first of its observations in FrameFeatures::mv_refs
   int16_t size = 0;           // number of observations (cameras)
-  bool has_point = false;     // the point is metric (well triangulated)
-  Vec3 p_b = Vec3::Zero();    // point in the body frame, when has_point (else a rough estimate)
-  float relative_depth_sigma = 0;
+  bool has_point = false;     // triangulated: in front of every camera, consistent with every keypoint
+  bool metric = false;        // and its depth is certain (relative sigma below the configured bound)
+  Vec3 p_b = Vec3::Zero();    // point in the body frame, when has_point
+  float relative_depth_sigma = 0;  // standard deviation of the depth over the depth
   Descriptor descriptor{};    // representative (medoid) descriptor
 };
 

@@ -19,13 +19,16 @@ struct MultiViewOptions {
   double epipolar_px = 2.0;         // gate, in pixels at octave 0 (scaled by the keypoint's octave sigma)
   float octave_scale = 1.2f;        // pyramid scale factor: sigma = scale^octave
   int max_octave_difference = 2;    // scale consistency between the two keypoints
-  TriangulationOptions triangulation;
+  TriangulationOptions triangulation;  // max_relative_depth_sigma decides which points are metric
+
+  MultiViewOptions() { triangulation.max_relative_depth_sigma = 0.01; }
 };
 
 struct MultiViewStats {
   int pair_matches = 0;     // accepted pairwise matches
   int tracks = 0;           // multi-view features
   int tracks_with_point = 0;
+  int metric_tracks = 0;    // with a depth certain to the configured bound
   int dropped = 0;          // tracks rejected by geometry
 };
 

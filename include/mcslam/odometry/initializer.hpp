@@ -15,9 +15,11 @@ class Initializer {
  public:
   Initializer(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
 
-  // Metric multi-view features in the frame.
-  static int metricMultiView(const FrameFeatures& f);
-  bool oneFrameReady(const FrameFeatures& f) const { return metricMultiView(f) >= options_.init_min_multiview; }
+  // Multi-view features whose point is certain enough to become a landmark.
+  static int usableMultiView(const FrameFeatures& f, double max_depth_sigma);
+  bool oneFrameReady(const FrameFeatures& f) const {
+    return usableMultiView(f, options_.landmark_max_depth_sigma) >= options_.init_min_multiview;
+  }
 
   enum class TwoFrame { Waiting, Ready };
   // Feeds a frame to the two-frame initialization. Ready: T_ref_cur (current body frame -> reference body

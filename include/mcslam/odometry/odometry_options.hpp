@@ -31,12 +31,13 @@ struct OdometryOptions {
   double keyframe_translation_ratio = 0.08;  // translation / median scene depth since the last keyframe
 
   // Initialization.
-  int init_min_multiview = 60;     // metric multi-view features needed to initialize from one frame
+  int init_min_multiview = 40;     // metric multi-view features needed to initialize from one frame
   int init_max_reference_age = 40; // two-frame initialization: renew the reference frame after this many frames
   int init_min_matches = 60;
 
   // Mapping.
-  int temporal_keyframes = 2;            // previous keyframes searched for new points
+  double landmark_max_depth_sigma = 0.06;  // multi-view points become landmarks below this relative depth sigma
+  int temporal_keyframes = 5;            // previous keyframes searched for new points (newest first)
   TriangulationOptions new_points;       // acceptance of new points triangulated across keyframes
   int cull_min_visible = 8;              // frames a landmark must have been predicted before its ratio counts
   double cull_min_found_ratio = 0.25;    // found / visible below this: erased
@@ -49,8 +50,10 @@ struct OdometryOptions {
   double extrinsic_sigma_rotation_deg = 1.0;
 
   OdometryOptions() {
-    new_points.max_relative_depth_sigma = 0.06;
-    new_points.min_parallax_deg = 0.5;
+    // Points from different keyframes need the parallax of ORB-SLAM's rule (about 1 degree) and a depth
+    // known to 15%: the back-end refines them from there.
+    new_points.max_relative_depth_sigma = 0.15;
+    new_points.min_parallax_deg = 1.0;
   }
 };
 

@@ -1,0 +1,97 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/features/multiview_matcher.hpp"
+#include "mcslam/odometry/odometry.hpp"
+#include "synthetic_sequence.hpp"
+#include "test_support.hpp"
+
+using namespace mcslam;
+
+namespace {
+
+Rig isec() { return loadKalibrRig(test::dataPath("calib/isec_5cam_camchain.yaml")); }
+
+// The centre front camera and two cameras looking left and right from the same mount.
+Rig nonOverlapping3() {
+  const Rig full = isec();
+  Rig rig;
+  RigCamera front = full.cameras[2];
+  front.T_b_c = SE3();
+  rig.cameras.push_back(front);
+  for (double yaw : {-M_PI / 2, M_PI / 2}) {
+    RigCamera side = front;
+    const Mat3 R = Eigen::AngleAxisd(yaw, Vec3::UnitY()).toRotationMatrix();
+    side.T_b_c = SE3(R, Vec3(0.0, 0.0, -0.1));
+    rig.cameras.push_back(side);
+  }
+  for (int i = 0; i < rig.size(); ++i) rig.cameras[i].name = "cam" + std::to_string(i);
+  return rig;
+}
+
+struct RunResult {
+  Trajectory estimate;
+  OdometryStats stats;
+  double ate = 0;
+  double scale = 1;
+  uint64_t allocations_after_warmup = 0;
+};
+
+RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, bool sim3) {
+  test::SyntheticSequence seq(rig, so);
+  OverlapMap overlap(rig, OverlapOptions{});
+  MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
+  OdometryOptions oo;
+  Odometry odo(rig, oo, so.max_features);
+  FrameFeatures f(rig.size(), so.max_features);
+  RunResult r;
+  for (int i = 0; i < seq.frames(); ++i) {
+    seq.fill(i, f);
+    matcher.compute(f);
+    PoseEstimate pose;
+    odo.process(f, i, pose);
+    if (pose.valid && pose.state == TrackingState::Tracking) r.estimate.push_back({pose.t, pose.T_w_b});
+  }
+  r.stats = odo.stats();
+  r.ate = test::alignedRmse(seq.groundTruth(), r.estimate, sim3, &r.scale);
+  std::printf("cams %d: frames %llu tracking %llu lost %llu notinit %llu kf %llu inits %llu recov %llu  ATE %.4f m scale %.4f\n",
+              rig.size(), (unsigned long long)r.stats.frames, (unsigned long long)r.stats.tracking,
+              (unsigned long long)r.stats.lost, (unsigned long long)r.stats.not_initialized,
+              (unsigned long long)r.stats.keyframes, (unsigned long long)r.stats.initializations,
+              (unsigned long long)r.stats.recoveries, r.ate, r.scale);
+  return r;
+}
+
+}  // namespace
+
+TEST(OdometrySynthetic, FiveOverlappingCameras) {
+  test::SyntheticSequenceOptions so;
+  const RunResult r = runSequence(isec(), so, false);
+  EXPECT_EQ(r.stats.lost, 0u);
+  EXPECT_EQ(r.stats.initializations, 1u);
+  EXPECT_LT(r.ate, 0.05);
+}
+
+TEST(OdometrySynthetic, Stereo) {
+  test::SyntheticSequenceOptions so;
+  const RunResult r = runSequence(isec().subset({1, 2}), so, false);
+  EXPECT_EQ(r.stats.lost, 0u);
+  EXPECT_LT(r.ate, 0.08);
+}
+
+TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
+  test::SyntheticSequenceOptions so;
+  const RunResult r = runSequence(nonOverlapping3(), so, true);
+  EXPECT_EQ(r.stats.lost, 0u);
+  EXPECT_NEAR(r.scale, 1.0, 0.05);
+}
+
+TEST(OdometrySynthetic, OneCameraUpToScale) {
+  test::SyntheticSequenceOptions so;
+  const RunResult r = runSequence(isec().subset({2}), so, true);
+  EXPECT_EQ(r.stats.lost, 0u);
+  EXPECT_GT(r.stats.tracking, 150u);
+}

@@ -1,0 +1,144 @@
+#include "synthetic_sequence.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace mcslam::test {
+
+namespace {
+// World: z up. Body: camera-like (x right, y down, z forward), moving in the horizontal plane.
+SE3 bodyPose(double s, double radius) {
+  // A loop with a wobble: the heading changes at varying rates (up to ~40 deg/s at 1 m/s).
+  const double a = s / radius;
+  const double r = radius * (1.0 + 0.25 * std::sin(3.0 * a));
+  const Vec3 p(r * std::cos(a), r * std::sin(a), 0.6);
+  const double a2 = a + 1e-3;
+  const double r2 = radius * (1.0 + 0.25 * std::sin(3.0 * a2));
+  const Vec3 q(r2 * std::cos(a2), r2 * std::sin(a2), 0.6);
+  const Vec3 forward = (q - p).normalized();
+  const Vec3 down(0, 0, -1);
+  const Vec3 right = down.cross(forward);  // x = y cross z
+  Mat3 R;
+  R.col(0) = right;
+  R.col(1) = down;
+  R.col(2) = forward;
+  return SE3(R, p);
+}
+}  // namespace
+
+SyntheticSequence::SyntheticSequence(const Rig& rig, const SyntheticSequenceOptions& o)
+    : rig_(rig), options_(o), rng_(o.seed) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::uniform_int_distribution<uint64_t> bits;
+  // Points on a cylinder wall around the loop, on the floor and on a few pillars inside.
+  const double wall = o.radius_m * 1.25 + 3.0;
+  for (int i = 0; i < o.points; ++i) {
+    Vec3 p;
+    const double kind = u(rng_);
+    if (kind < 0.6) {
+      const double a = 2 * M_PI * u(rng_);
+      const double rr = wall + 2.0 * u(rng_);
+      p = Vec3(rr * std::cos(a), rr * std::sin(a), 3.0 * u(rng_));
+    } else if (kind < 0.8) {
+      const double a = 2 * M_PI * u(rng_);
+      const double rr = o.radius_m * 0.5 * u(rng_);
+      p = Vec3(rr * std::cos(a), rr * std::sin(a), 2.5 * u(rng_));
+    } else {
+      const double a = 2 * M_PI * u(rng_);
+      const double rr = wall * std::sqrt(u(rng_));
+      p = Vec3(rr * std::cos(a), rr * std::sin(a), 0.0);
+    }
+    points_.push_back(p);
+    Descriptor d;
+    for (auto& w : d) w = bits(rng_);
+    descriptors_.push_back(d);
+    // Octaves as an ORB pyramid spreads them (each level holds 1/1.2 of the one below); a point keeps its
+    // octave in every view, as its image scale changes little along the sequence.
+    int octave = 0;
+    while (octave < 7 && u(rng_) < 1.0 / 1.2) ++octave;
+    octaves_.push_back(octave);
+  }
+  const double length_per_frame = o.speed_mps / o.rate_hz;
+  for (int i = 0; i < o.frames; ++i) {
+    StampedPose sp;
+    sp.t = static_cast<Timestamp>(i * 1e9 / o.rate_hz);
+    sp.T_w_b = bodyPose(i * length_per_frame, o.radius_m);
+    truth_.push_back(sp);
+  }
+}
+
+void SyntheticSequence::fill(int i, FrameFeatures& out) {
+  std::normal_distribution<double> noise(0.0, options_.noise_px);
+  std::uniform_int_distribution<int> bit(0, 255);
+  out.clear();
+  out.t = truth_[i].t;
+  const SE3& T_w_b = truth_[i].T_w_b;
+  for (int c = 0; c < rig_.size(); ++c) {
+    out.present[c] = 1;
+    const SE3 T_c_w = (T_w_b * rig_.T_b_c(c)).inverse();
+    const CameraModel& m = rig_.model(c);
+    struct Item {
+      double depth;
+      int point;
+      Vec2 uv;
+    };
+    std::vector<Item> items;
+    for (int p = 0; p < static_cast<int>(points_.size()); ++p) {
+      const Vec3 pc = T_c_w * points_[p];
+      Vec2 uv;
+      if (pc.z() < 0.2 || !m.project(pc, uv) || !m.inImage(uv, 20)) continue;
+      items.push_back({pc.z(), p, uv});
+    }
+    // The detector keeps the best-spread features up to its budget: here the nearest ones.
+    std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.depth < b.depth; });
+    FeatureSet& set = out.sets[c];
+    set.count = 0;
+    for (const Item& it : items) {
+      if (set.count == set.capacity()) break;
+      Keypoint kp;
+      const int octave = octaves_[it.point];
+      const double sigma = std::pow(1.2, octave);
+      kp.x = static_cast<float>(it.uv.x() + noise(rng_) * sigma);
+      kp.y = static_cast<float>(it.uv.y() + noise(rng_) * sigma);
+      kp.octave = static_cast<int8_t>(octave);
+      Descriptor d = descriptors_[it.point];
+      for (int f = 0; f < 10; ++f) {
+        const int b = bit(rng_);
+        d[b / 64] ^= uint64_t{1} << (b % 64);
+      }
+      set.keypoints[set.count] = kp;
+      set.descriptors[set.count] = d;
+      ++set.count;
+    }
+  }
+}
+
+double alignedRmse(const Trajectory& truth, const Trajectory& est, bool scale, double* scale_out) {
+  std::map<Timestamp, Vec3> gt;
+  for (const auto& p : truth) gt[p.t] = p.T_w_b.t;
+  std::vector<Vec3> a, b;
+  for (const auto& p : est) {
+    const auto it = gt.find(p.t);
+    if (it == gt.end()) continue;
+    a.push_back(p.T_w_b.t);
+    b.push_back(it->second);
+  }
+  if (a.size() < 3) return 1e9;
+  Eigen::Matrix3Xd A(3, a.size()), B(3, b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    A.col(i) = a[i];
+    B.col(i) = b[i];
+  }
+  const Eigen::Matrix4d T = Eigen::umeyama(A, B, scale);
+  if (scale_out) *scale_out = T.topLeftCorner<3, 3>().determinant() > 0 ? std::cbrt(T.topLeftCorner<3, 3>().determinant()) : 0;
+  double sum = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const Vec3 p = T.topLeftCorner<3, 3>() * a[i] + T.topRightCorner<3, 1>();
+    sum += (p - b[i]).squaredNorm();
+  }
+  return std::sqrt(sum / a.size());
+}
+
+}  // namespace mcslam::test
