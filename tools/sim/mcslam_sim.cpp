@@ -11,6 +11,7 @@
 #include "mcslam/sim/dataset_export.hpp"
 #include "mcslam/sim/rig_presets.hpp"
 #include "mcslam/sim/simulation.hpp"
+#include "contact_sheet.hpp"
 
 using namespace mcslam;
 namespace fs = std::filesystem;
@@ -28,6 +29,8 @@ std::string footer() {
          "  DIR/groundtruth.txt          TUM poses (t tx ty tz qx qy qz qw) of the body in the world, z up\n"
          "  DIR/sim.yaml                 the settings used\n"
          "\nWith no options: isec rig, indoor world, one ground-robot loop at 10 Hz, into ./mcslam_sim_out.\n"
+         "With --preview FILE.png (and no --out): only a contact sheet of one frame of the selected cameras,\n"
+         "labelled with their rig indices - to see what a rig sees before rendering a whole sequence.\n"
          "Same seed, same bytes (whatever --threads).\n";
 }
 
@@ -52,13 +55,57 @@ void prepareOutput(const std::string& dir, bool overwrite) {
   }
 }
 
+// Checks what can be checked before the (slow) world build, so mistakes are reported at once.
+void validateEarly(const sim::SimulationConfig& cfg, const std::vector<int>& cameras, const std::string& preview,
+                   double preview_scale, int preview_frame) {
+  const Rig rig = sim::loadRig(cfg.rig);
+  if (!cameras.empty()) {
+    try {
+      rig.subset(cameras);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--cameras: ") + e.what());
+    }
+  }
+  if (!(preview_scale > 0 && preview_scale <= 1)) {
+    throw InputError("--preview-scale must be in (0, 1], got " + std::to_string(preview_scale));
+  }
+  if (preview_frame < 0) throw InputError("--preview-frame must not be negative, got " + std::to_string(preview_frame));
+  if (preview.empty()) return;
+  const fs::path p(preview);
+  if (p.extension() != ".png" && p.extension() != ".PNG") {
+    throw InputError("--preview " + preview + ": the contact sheet is a PNG, name it *.png");
+  }
+  std::error_code ec;
+  if (p.has_parent_path() && !fs::is_directory(p.parent_path(), ec)) {
+    throw InputError("--preview " + preview + ": folder " + p.parent_path().string() + " does not exist");
+  }
+}
+
+// One frame of the given cameras as a contact sheet.
+void writePreview(sim::Simulation& simulation, const std::vector<int>& cameras, int frame, double scale,
+                  const std::string& path) {
+  if (frame >= simulation.frameCount()) {
+    throw InputError("--preview-frame " + std::to_string(frame) + " is beyond the last frame (" +
+                     std::to_string(simulation.frameCount() - 1) + ")");
+  }
+  std::vector<Image> images(cameras.size());
+  std::vector<sim::SheetTile> tiles;
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    simulation.render(frame, cameras[k], images[k]);
+    tiles.push_back({&images[k], "cam" + std::to_string(cameras[k])});
+  }
+  sim::writeContactSheet(path, tiles, scale);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-sim: render a multi-camera sequence with exact ground truth (ASL dataset + depth)"};
   app.footer(footer());
   sim::SimulationConfig cfg;
-  std::string out = "mcslam_sim_out", cameras;
+  std::string out = "mcslam_sim_out", cameras, preview;
+  double preview_scale = 0.5;
+  int preview_frame = 0;
   bool no_depth = false, no_noise = false, no_exposure = false, no_vignetting = false, no_aa = false;
   bool overwrite = false, quiet = false;
   double blur_ms = 0.0;
@@ -84,6 +131,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--overwrite", overwrite, "Replace the output of a previous run in --out");
   app.add_flag("--quiet", quiet, "No progress output");
+  app.add_option("--preview", preview,
+                 "Write a contact sheet (PNG) of one frame of the selected cameras; without --out, only that");
+  app.add_option("--preview-frame", preview_frame, "Frame shown by --preview")->capture_default_str();
+  app.add_option("--preview-scale", preview_scale, "Size of each camera in the contact sheet, relative to its resolution")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -102,14 +154,30 @@ int main(int argc, char** argv) {
     cfg.render.sensor.motion_blur_s = blur_ms * 1e-3;
     if (cfg.render.threads < 0) throw InputError("--threads must not be negative");
     sim::ExportOptions options;
-    if (!cameras.empty()) options.cameras = parseCameraList(cameras);
+    if (!cameras.empty()) {
+      try {
+        options.cameras = parseCameraList(cameras);
+      } catch (const InputError& e) {
+        throw InputError(std::string("--cameras: ") + e.what());
+      }
+    }
     options.depth = !no_depth;
-    prepareOutput(out, overwrite);
+    validateEarly(cfg, options.cameras, preview, preview_scale, preview_frame);
+    const bool write_dataset = preview.empty() || app.count("--out") > 0;
+    if (write_dataset) prepareOutput(out, overwrite);
 
     const Timestamp t0 = monotonicNowNs();
     sim::Simulation simulation(cfg);
-    if (!options.cameras.empty()) simulation.rig().subset(options.cameras);  // validates the indices early
-    const int cams = options.cameras.empty() ? simulation.rig().size() : static_cast<int>(options.cameras.size());
+    std::vector<int> selected = options.cameras;
+    if (selected.empty()) {
+      for (int c = 0; c < simulation.rig().size(); ++c) selected.push_back(c);
+    }
+    if (!preview.empty()) {
+      writePreview(simulation, selected, preview_frame, preview_scale, preview);
+      if (!quiet) std::fprintf(stderr, "mcslam-sim: wrote %s (frame %d)\n", preview.c_str(), preview_frame);
+    }
+    if (!write_dataset) return 0;
+    const int cams = static_cast<int>(selected.size());
     if (!quiet) {
       std::fprintf(stderr, "mcslam-sim: %s world, %s, %d frames at %.3g Hz, %d cameras -> %s\n", cfg.world.c_str(),
                    simulation.trajectory().description().c_str(), simulation.frameCount(), cfg.rate_hz, cams,
