@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/alloc_counter.hpp"
@@ -52,16 +53,21 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
     seq.fill(i, f);
     matcher.compute(f);
     PoseEstimate pose;
+    alloc::ThreadScope scope;
     odo.process(f, i, pose);
+    if (i >= so.warmup_frames) {
+      r.allocations_after_warmup += scope.count();
+      if (scope.count() && std::getenv("MCSLAM_DEBUG_ALLOC")) std::printf("frame %d allocs %llu\n", i, (unsigned long long)scope.count());
+    }
     if (pose.valid && pose.state == TrackingState::Tracking) r.estimate.push_back({pose.t, pose.T_w_b});
   }
   r.stats = odo.stats();
   r.ate = test::alignedRmse(seq.groundTruth(), r.estimate, sim3, &r.scale);
-  std::printf("cams %d: frames %llu tracking %llu lost %llu notinit %llu kf %llu inits %llu recov %llu  ATE %.4f m scale %.4f\n",
+  std::printf("cams %d: frames %llu tracking %llu lost %llu notinit %llu kf %llu inits %llu recov %llu  ATE %.4f m scale %.4f allocs %llu\n",
               rig.size(), (unsigned long long)r.stats.frames, (unsigned long long)r.stats.tracking,
               (unsigned long long)r.stats.lost, (unsigned long long)r.stats.not_initialized,
               (unsigned long long)r.stats.keyframes, (unsigned long long)r.stats.initializations,
-              (unsigned long long)r.stats.recoveries, r.ate, r.scale);
+              (unsigned long long)r.stats.recoveries, r.ate, r.scale, (unsigned long long)r.allocations_after_warmup);
   return r;
 }
 
@@ -73,6 +79,7 @@ TEST(OdometrySynthetic, FiveOverlappingCameras) {
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_EQ(r.stats.initializations, 1u);
   EXPECT_LT(r.ate, 0.05);
+  if (alloc::available()) EXPECT_EQ(r.allocations_after_warmup, 0u);  // keyframes, mapping and back-end included
 }
 
 TEST(OdometrySynthetic, Stereo) {
@@ -80,6 +87,7 @@ TEST(OdometrySynthetic, Stereo) {
   const RunResult r = runSequence(isec().subset({1, 2}), so, false);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_LT(r.ate, 0.08);
+  if (alloc::available()) EXPECT_EQ(r.allocations_after_warmup, 0u);
 }
 
 TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
@@ -94,4 +102,5 @@ TEST(OdometrySynthetic, OneCameraUpToScale) {
   const RunResult r = runSequence(isec().subset({2}), so, true);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_GT(r.stats.tracking, 150u);
+  if (alloc::available()) EXPECT_EQ(r.allocations_after_warmup, 0u);
 }

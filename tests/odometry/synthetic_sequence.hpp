@@ -21,6 +21,7 @@ struct SyntheticSequenceOptions {
   int points = 15000;
   int max_features = 1000;
   uint64_t seed = 1;
+  int warmup_frames = 60;  // frames before allocations are counted (the map and pools reach steady use)
 };
 
 class SyntheticSequence {

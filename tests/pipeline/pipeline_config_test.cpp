@@ -48,3 +48,11 @@ TEST(PipelineConfig, BadValuesNameFileAndKey) {
   EXPECT_NE(errorOf("capacity: {max_keyframes: 8, window_keyframes: 8}").find("max_keyframes"), std::string::npos);
   EXPECT_NE(errorOf("multiview: {min_depth: 5, max_depth: 2}").find("max_depth"), std::string::npos);
 }
+
+// config/slam.yaml documents the defaults: it must stay equal to them.
+TEST(PipelineConfig, ShippedSlamYamlHoldsTheDefaults) {
+  const YAML::Node file = YAML::LoadFile(MCSLAM_SOURCE_DIR "/config/slam.yaml");
+  const PipelineConfig shipped = parsePipelineConfig(file["slam"], "config/slam.yaml", isec());
+  const PipelineConfig defaults = parsePipelineConfig(YAML::Node(), "defaults", isec());
+  EXPECT_EQ(formatPipelineConfig(shipped), formatPipelineConfig(defaults));
+}

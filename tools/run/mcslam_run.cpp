@@ -57,7 +57,7 @@ void progress(std::size_t done, std::size_t total, double ms_per_frame, const Po
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
   std::string dataset_dir, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
-  bool quiet = false;
+  bool quiet = false, print_config = false;
   app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
       ->required();
   app.add_option("--config", config_path, "YAML file with a `slam:` section (see config/slam.yaml); defaults otherwise");
@@ -67,6 +67,8 @@ int main(int argc, char** argv) {
   app.add_option("--stats", stats_path, "Timing per stage (mean, p99) and tracking states, JSON");
   app.add_option("--extrinsics", extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_flag("--quiet", quiet, "No progress bar");
+  app.add_flag("--print-config", print_config,
+               "Print the effective `slam:` configuration (defaults, --config, this dataset's rig) and exit");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -77,6 +79,10 @@ int main(int argc, char** argv) {
     if (ds.size() == 0) throw InputError(dataset_dir + ": the dataset has no frames");
     const PipelineConfig config = parsePipelineConfig(slamSection(config_path), config_path.empty() ? "defaults" : config_path,
                                                       ds.rig());
+    if (print_config) {
+      std::fputs(formatPipelineConfig(config).c_str(), stdout);
+      return 0;
+    }
     SlamPipeline pipeline(ds.rig(), config);
     run::RunReport report;
     const bool show = !quiet && ::isatty(STDERR_FILENO);
