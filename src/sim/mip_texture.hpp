@@ -36,9 +36,8 @@ class MipTexture {
       l0 = static_cast<int>(lod);
       f = lod - static_cast<float>(l0);
     }
-    const float a = bilinear(levels_[l0], u, v);
-    if (f < 1.0f / 64.0f) return a;
-    return a + f * (bilinear(levels_[l0 + 1], u, v) - a);
+    if (f < 1.0f / 64.0f) return bilinear(levels_[l0], u, v);
+    return trilinear(levels_[l0], levels_[l0 + 1], u, v, f);
   }
 
  private:
@@ -70,6 +69,47 @@ class MipTexture {
     const float a = t00 + fx * (t10 - t00);
     const float b = t01 + fx * (t11 - t01);
     return a + fy * (b - a);
+  }
+  // Both levels' bilinear lookups at once (the hot path of shading): the same float operations as bilinear() on
+  // each, so the result is bit-identical, with a quarter of the int-to-float conversions and half the lerps.
+  __attribute__((always_inline)) float trilinear(const Level& A, const Level& B, float u, float v, float f) const {
+    typedef float f4 __attribute__((vector_size(16)));
+    typedef int32_t i4 __attribute__((vector_size(16)));
+    int ax0, ay0, ax1, ay1, bx0, by0, bx1, by1;
+    float afx, afy, bfx, bfy;
+    texelCoords(A, u, v, ax0, ay0, ax1, ay1, afx, afy);
+    texelCoords(B, u, v, bx0, by0, bx1, by1, bfx, bfy);
+    const uint8_t* a0 = data_.get() + A.offset + static_cast<std::size_t>(ay0) * A.w;
+    const uint8_t* a1 = data_.get() + A.offset + static_cast<std::size_t>(ay1) * A.w;
+    const uint8_t* b0 = data_.get() + B.offset + static_cast<std::size_t>(by0) * B.w;
+    const uint8_t* b1 = data_.get() + B.offset + static_cast<std::size_t>(by1) * B.w;
+    // Lanes: (row 0, row 1) of level A, then of level B.
+    const f4 left = __builtin_convertvector((i4{a0[ax0], a1[ax0], b0[bx0], b1[bx0]}), f4);
+    const f4 right = __builtin_convertvector((i4{a0[ax1], a1[ax1], b0[bx1], b1[bx1]}), f4);
+    const f4 fx = {afx, afx, bfx, bfx};
+    const f4 rows = left + fx * (right - left);
+    const float a = rows[0] + afy * (rows[1] - rows[0]);
+    const float b = rows[2] + bfy * (rows[3] - rows[2]);
+    return a + f * (b - a);
+  }
+  __attribute__((always_inline)) void texelCoords(const Level& L, float u, float v, int& x0, int& y0, int& x1, int& y1,
+                                                  float& fx, float& fy) const {
+    const float x = u * L.scale - 0.5f, y = v * L.scale - 0.5f;
+    x0 = floorInt(x);
+    y0 = floorInt(y);
+    fx = x - static_cast<float>(x0);
+    fy = y - static_cast<float>(y0);
+    if (wrap_) {
+      x0 &= L.w - 1;
+      y0 &= L.h - 1;
+      x1 = (x0 + 1) & (L.w - 1);
+      y1 = (y0 + 1) & (L.h - 1);
+    } else {
+      x1 = clampi(x0 + 1, L.w);
+      y1 = clampi(y0 + 1, L.h);
+      x0 = clampi(x0, L.w);
+      y0 = clampi(y0, L.h);
+    }
   }
   // std::floor is slow on the baseline x86-64 target (no SSE4.1 round instruction).
   static int floorInt(float v) {

@@ -28,6 +28,9 @@ struct Renderer::Impl {
   SensorModel sensor;
   FrameContext ctx;
   std::vector<std::shared_ptr<const CameraLut>> luts;
+  // Per camera and pixel: the vignetting gain, 0 outside the lens's valid domain. Saves the sensor pass from
+  // streaming the 16-byte rays of the whole image again.
+  std::vector<std::vector<float>> vignettes;
   const CameraLut* lut = nullptr;
   std::vector<uint32_t> key;  // per pixel: surface hit by the centre ray
   std::vector<float> t;       // and its distance
@@ -76,7 +79,17 @@ void Renderer::Impl::visibilityPass(int tile) {
 
 bool Renderer::Impl::isEdge(int x, int y) const {
   const int W = lut->width, H = lut->height;
-  const uint32_t k = key[static_cast<std::size_t>(y) * W + x];
+  const std::size_t i = static_cast<std::size_t>(y) * W + x;
+  const uint32_t k = key[i];
+  if (x > 0 && y > 0 && x < W - 1 && y < H - 1) {
+    // Interior pixel: most see the same surface as all 8 neighbours; only then is validity worth checking.
+    const uint32_t* a = &key[i - W];
+    const uint32_t* c = &key[i + W];
+    if (((a[-1] ^ k) | (a[0] ^ k) | (a[1] ^ k) | (key[i - 1] ^ k) | (key[i + 1] ^ k) | (c[-1] ^ k) | (c[0] ^ k) |
+         (c[1] ^ k)) == 0) {
+      return false;
+    }
+  }
   for (int dy = -1; dy <= 1; ++dy) {
     const int yy = y + dy;
     if (yy < 0 || yy >= H) continue;
@@ -179,7 +192,15 @@ Renderer::Renderer(std::shared_ptr<const World> world, Rig rig, RenderOptions op
   options_.edge_samples = std::clamp(options_.edge_samples, 1, 64);
   options_.sensor.motion_blur_samples = std::clamp(options_.sensor.motion_blur_samples | 1, 1, 63);
   impl_ = std::make_unique<Impl>(options_, world_->data());
-  for (const RigCamera& c : rig_.cameras) impl_->luts.push_back(CameraLut::get(c.model, options_.tile_size, impl_->pool));
+  for (const RigCamera& c : rig_.cameras) {
+    impl_->luts.push_back(CameraLut::get(c.model, options_.tile_size, impl_->pool));
+    const CameraLut& lut = *impl_->luts.back();
+    std::vector<float>& v = impl_->vignettes.emplace_back(static_cast<std::size_t>(lut.width) * lut.height);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const float* r = &lut.rays[4 * i];
+      v[i] = r[3] > 0.f ? impl_->sensor.vignette(r[2]) : 0.f;
+    }
+  }
   // N-rooks pattern: every column and every row of an n x n grid holds one sample.
   const int n = options_.edge_samples;
   int stride = n > 2 ? 3 : 1;
@@ -237,13 +258,12 @@ void Renderer::render(int cam, const std::function<SE3(double)>& T_w_b_at, doubl
 
   const float gain = static_cast<float>(exposureGain(cam, time_s));
   const uint64_t stream = hashOf(options_.seed, frame_key, static_cast<uint64_t>(cam));
+  const float* vignette = m.vignettes[cam].data();
   m.pool.run(H, [&](int y) {
     uint8_t* row = image.row(y);
     for (int x = 0; x < W; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * W + x;
-      const float* r = m.lut->ray(x, y);
-      row[x] = r[3] > 0.f ? m.sensor.encode(m.radiance[i] * gain, m.sensor.vignette(r[2]), stream, static_cast<uint32_t>(i))
-                          : 0;
+      row[x] = vignette[i] > 0.f ? m.sensor.encode(m.radiance[i] * gain, vignette[i], stream, static_cast<uint32_t>(i)) : 0;
     }
   });
 }
