@@ -36,32 +36,25 @@ PathStats walk(const SimTrajectory& traj, const SE3& T_v_b) {
   return s;
 }
 
-class SimTrajectories : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() { world_ = makeWorld("indoor"); }
-  static void TearDownTestSuite() { world_.reset(); }
-  static std::shared_ptr<const World> world_;
-  const SE3 mount_ = rigMount(makePresetRig("isec"));
-};
-std::shared_ptr<const World> SimTrajectories::world_;
+// One test for both motions: building the indoor world is most of the time, and CTest runs every test alone.
+TEST(SimTrajectories, IndoorGroundLoopIsLongTurnsFastAndClosesHandheldWalkClosesToo) {
+  const auto world = makeWorld("indoor");
+  const SE3 mount = rigMount(makePresetRig("isec"));
 
-TEST_F(SimTrajectories, GroundLoopOfIndoorWorldIsLongTurnsFastAndCloses) {
-  const auto traj = makeGroundTrajectory(*world_, 1);
-  const PathStats s = walk(*traj, mount_);
+  const auto ground = makeGroundTrajectory(*world, 1);
+  const PathStats s = walk(*ground, mount);
   EXPECT_GE(s.length, 60.0);
   EXPECT_LT(s.end_gap, 0.01) << "metres between start and end";
   EXPECT_LT(s.end_angle_deg, 0.5);
   EXPECT_GE(s.max_yaw_rate, 30.0);
-  RecordProperty("length_m", std::to_string(s.length));
-  RecordProperty("max_yaw_rate_deg_s", std::to_string(s.max_yaw_rate));
-}
+  ::testing::Test::RecordProperty("length_m", std::to_string(s.length));
+  ::testing::Test::RecordProperty("max_yaw_rate_deg_s", std::to_string(s.max_yaw_rate));
 
-TEST_F(SimTrajectories, HandheldWalkCloses) {
-  const auto traj = makeHandheldTrajectory(*world_, 1);
-  const PathStats s = walk(*traj, mount_);
-  EXPECT_GE(s.length, 60.0);
-  EXPECT_LT(s.end_gap, 0.01) << "metres between start and end";
-  EXPECT_LT(s.end_angle_deg, 0.5);
+  const auto handheld = makeHandheldTrajectory(*world, 1);
+  const PathStats h = walk(*handheld, mount);
+  EXPECT_GE(h.length, 60.0);
+  EXPECT_LT(h.end_gap, 0.01) << "hand-held: metres between start and end";
+  EXPECT_LT(h.end_angle_deg, 0.5) << "hand-held";
 }
 
 }  // namespace
