@@ -5,7 +5,9 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "daemon/synced_file.hpp"
 #include "gpio/gpiod_line.hpp"
+#include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
 #include "realtime/scheduling.hpp"
 #include "sources/source_factory.hpp"
@@ -39,14 +41,14 @@ int64_t realtimeNowNs() {
 }
 }  // namespace
 
-std::string trajectoryPathFor(const DaemonConfig& c) {
+std::string outputPathFor(const DaemonConfig& c, const std::string& name) {
   std::string dir = c.output.directory;
   if (dir.empty()) {
     const char* state = std::getenv("STATE_DIRECTORY");  // systemd: StateDirectory=, maybe colon-separated
     if (state && *state) dir = std::string(state).substr(0, std::string(state).find(':'));
   }
   const std::filesystem::path base = dir.empty() ? std::filesystem::current_path() : std::filesystem::path(dir);
-  return (base / c.output.trajectory).string();
+  return (base / name).string();
 }
 
 Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> processor,
@@ -75,6 +77,7 @@ Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> proce
     trigger_thread_ = std::make_unique<TriggerThread>(*out, trigger_log_, t.rate_hz, config.realtime.trigger_priority);
   }
   trajectory_ = std::make_unique<TrajectoryWriter>(trajectoryPathFor(config));
+  if (!config.output.extrinsics.empty()) extrinsics_path_ = outputPathFor(config, config.output.extrinsics);
   if (config.realtime.lock_memory) {
     if (const std::string why = lockAllMemory(); !why.empty()) spdlog::warn("realtime.lock_memory: {}", why);
   }
@@ -115,7 +118,26 @@ bool Daemon::stop(int64_t grace_ns) {
   publishing_thread_.join();
   trajectory_->close();  // fsync
   if (shm_) shm_->markStopped();
+  if (processing_finished) writeRefinedExtrinsics();  // else the pipeline may still be inside process()
+  else if (!extrinsics_path_.empty()) spdlog::error("refined extrinsics not written: the pipeline did not stop");
   return processing_finished;
+}
+
+void Daemon::writeRefinedExtrinsics() {
+  if (extrinsics_path_.empty()) return;
+  Rig refined;
+  if (!processor_->refinedRig(refined)) {
+    spdlog::info("refined extrinsics: the pipeline provides none; nothing written");
+    return;
+  }
+  std::string error;
+  try {
+    extrinsics_written_ = writeFileSynced(extrinsics_path_, formatKalibrRig(refined), &error);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  if (extrinsics_written_) spdlog::info("refined extrinsics written to {}", extrinsics_path_);
+  else spdlog::error("output.extrinsics: {}", error);
 }
 
 bool Daemon::emitRigFrame(int64_t now, bool force) {

@@ -52,9 +52,11 @@ class Daemon {
   Daemon& operator=(const Daemon&) = delete;
 
   void start();
-  // Stops in order (trigger, source, assembly, processing, publishing), then fsyncs the trajectory.
+  // Stops in order (trigger, source, assembly, processing, publishing), then fsyncs the trajectory and
+  // writes the pipeline's refined extrinsics (output.extrinsics, fsynced).
   // Returns false when the processing thread did not finish within `processing_grace_ns` (it is then
-  // left behind; the trajectory of what was published is still complete and synced).
+  // left behind, and no extrinsics are written; the trajectory of what was published is still
+  // complete and synced).
   bool stop(int64_t processing_grace_ns = 1500000000);
 
   DaemonStats stats() const;
@@ -63,6 +65,9 @@ class Daemon {
   void health(char* out, std::size_t size) const { source_->health(out, size); }
   const DaemonConfig& config() const { return config_; }
   std::string trajectoryPath() const { return trajectory_->path(); }
+  // Empty when output.extrinsics is empty (not written).
+  const std::string& extrinsicsPath() const { return extrinsics_path_; }
+  bool extrinsicsWritten() const { return extrinsics_written_; }
 
  private:
   void assemblyLoop();
@@ -70,6 +75,7 @@ class Daemon {
   void publishingLoop();
   bool emitRigFrame(int64_t now, bool force);
   void publishPose(const PoseSlot& slot);
+  void writeRefinedExtrinsics();
 
   DaemonConfig config_;
   std::unique_ptr<FrameProcessor> processor_;
@@ -88,6 +94,8 @@ class Daemon {
   std::unique_ptr<PoseShmWriter> shm_;
   UdpPoseSender udp_;
   std::unique_ptr<TrajectoryWriter> trajectory_;  // opened last: a failed start-up leaves files alone
+  std::string extrinsics_path_;
+  bool extrinsics_written_ = false;
 
   TriggerLog trigger_log_;
   std::unique_ptr<TriggerLine> gpio_line_;
@@ -108,7 +116,10 @@ class Daemon {
   uint64_t sequence_ = 0;  // publisher only
 };
 
-// The trajectory file path for a config: output.directory, else $STATE_DIRECTORY, else ".".
-std::string trajectoryPathFor(const DaemonConfig& config);
+// An output file's path: `name` in output.directory, else in $STATE_DIRECTORY, else in ".".
+std::string outputPathFor(const DaemonConfig& config, const std::string& name);
+inline std::string trajectoryPathFor(const DaemonConfig& config) {
+  return outputPathFor(config, config.output.trajectory);
+}
 
 }  // namespace mcslam::platform

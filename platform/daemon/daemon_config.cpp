@@ -1,5 +1,6 @@
 #include "daemon/daemon_config.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -8,6 +9,8 @@
 #include "mcslam/core/error.hpp"
 #include "mcslam/dataset/dataset.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
+#include "mcslam/sim/rig_presets.hpp"
+#include "mcslam/sim/world.hpp"
 #include "udp/udp_pose_sender.hpp"
 
 namespace mcslam::platform {
@@ -20,6 +23,50 @@ std::string resolvePath(const std::string& file, const std::string& path) {
   return (dir.empty() ? std::filesystem::path(path) : dir / path).lexically_normal().string();
 }
 
+std::vector<int> readCameraList(const YamlFields& f) {
+  std::vector<int> cameras;
+  if (!f.has("cameras")) return cameras;
+  const YAML::Node n = f.node("cameras");
+  if (!n.IsSequence()) f.fail("cameras", "expected a list of calibration indices");
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    int v = 0;
+    if (!n[i].IsScalar() || !YAML::convert<int>::decode(n[i], v) || v < 0)
+      f.fail("cameras", "item " + std::to_string(i) + " must be a camera index >= 0");
+    cameras.push_back(v);
+  }
+  return cameras;
+}
+
+void readSim(const YamlFields& f, SimSourceConfig& s) {
+  f.allowOnly({"rig", "world", "trajectory", "rate_hz", "frames", "seed", "pace", "at_end", "anti_aliasing",
+               "render_threads", "cameras"});
+  s.rig = f.string("rig", s.rig);
+  const auto presets = sim::rigPresetNames();
+  if (std::find(presets.begin(), presets.end(), s.rig) == presets.end()) s.rig = resolvePath(f.file(), s.rig);
+  const auto worlds = sim::worldNames();
+  s.world = f.string("world", s.world);
+  if (std::find(worlds.begin(), worlds.end(), s.world) == worlds.end()) {
+    std::string known;
+    for (const auto& w : worlds) known += (known.empty() ? "" : ", ") + w;
+    f.fail("world", "'" + s.world + "' is not one of " + known);
+  }
+  s.trajectory = f.string("trajectory", s.trajectory);
+  if (s.trajectory.rfind("file:", 0) == 0) {
+    s.trajectory = "file:" + resolvePath(f.file(), s.trajectory.substr(5));
+  } else if (s.trajectory != "ground" && s.trajectory != "handheld") {
+    f.fail("trajectory", "'" + s.trajectory + "' is not one of ground, handheld, file:PATH");
+  }
+  s.rate_hz = f.positiveNumber("rate_hz", s.rate_hz);
+  if (s.rate_hz > 1000) f.fail("rate_hz", "at most 1000 Hz, got " + std::to_string(s.rate_hz));
+  s.frames = static_cast<int>(f.integer("frames", s.frames, 0, 100000000));
+  s.seed = static_cast<uint64_t>(f.integer("seed", static_cast<long long>(s.seed), 0, 1ll << 62));
+  s.pace = f.choice("pace", s.pace, {"fastest", "realtime"});
+  s.at_end = f.choice("at_end", s.at_end, {"exit", "loop", "idle"});
+  s.anti_aliasing = f.boolean("anti_aliasing", s.anti_aliasing);
+  s.render_threads = static_cast<int>(f.integer("render_threads", s.render_threads, 0, 256));
+  s.cameras = readCameraList(f);
+}
+
 void readDataset(const YamlFields& f, DatasetSourceConfig& d) {
   f.allowOnly({"path", "rate", "speed", "at_end", "preload", "max_preload_frames", "cameras"});
   d.path = resolvePath(f.file(), f.requiredString("path"));
@@ -28,16 +75,7 @@ void readDataset(const YamlFields& f, DatasetSourceConfig& d) {
   d.at_end = f.choice("at_end", d.at_end, {"exit", "loop", "idle"});
   d.preload = f.boolean("preload", d.preload);
   d.max_preload_frames = f.capacity("max_preload_frames", d.max_preload_frames);
-  if (f.has("cameras")) {
-    const YAML::Node n = f.node("cameras");
-    if (!n.IsSequence()) f.fail("cameras", "expected a list of calibration indices");
-    for (std::size_t i = 0; i < n.size(); ++i) {
-      int v = 0;
-      if (!n[i].IsScalar() || !YAML::convert<int>::decode(n[i], v) || v < 0)
-        f.fail("cameras", "item " + std::to_string(i) + " must be a camera index >= 0");
-      d.cameras.push_back(v);
-    }
-  }
+  d.cameras = readCameraList(f);
 }
 
 void readAravis(const YamlFields& f, AravisSourceConfig& a) {
@@ -99,20 +137,19 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
   c.calibration = resolvePath(file, top.string("calibration", ""));
 
   const YamlFields source = top.child("source");
-  source.allowOnly({"type", "dataset", "aravis"});
-  if (!source.has("type")) source.fail("type", "missing (required): dataset or aravis");
-  c.source_type = source.choice("type", "", {"dataset", "aravis"});
-  if (c.source_type == "dataset") {
-    if (source.has("aravis")) source.fail("aravis", "given but source.type is dataset");
-    readDataset(source.child("dataset"), c.dataset);
-  } else {
-    if (source.has("dataset")) source.fail("dataset", "given but source.type is aravis");
-    readAravis(source.child("aravis"), c.aravis);
-  }
+  source.allowOnly({"type", "dataset", "aravis", "sim"});
+  if (!source.has("type")) source.fail("type", "missing (required): dataset, aravis or sim");
+  c.source_type = source.choice("type", "", {"dataset", "aravis", "sim"});
+  for (const char* other : {"dataset", "aravis", "sim"})
+    if (c.source_type != other && source.has(other)) source.fail(other, "given but source.type is " + c.source_type);
+  if (c.source_type == "dataset") readDataset(source.child("dataset"), c.dataset);
+  else if (c.source_type == "aravis") readAravis(source.child("aravis"), c.aravis);
+  else readSim(source.child("sim"), c.sim);
 
   readTrigger(top.child("trigger"), c.trigger);
-  if (c.source_type == "dataset" && c.trigger.mode == "gpio")
-    top.fail("trigger", "mode gpio needs cameras (source.type aravis); a dataset replays free_running or software");
+  if (c.source_type != "aravis" && c.trigger.mode == "gpio")
+    top.fail("trigger", "mode gpio needs cameras (source.type aravis); a " + c.source_type +
+                            " source runs free_running or software");
 
   const YamlFields assembly = top.child("assembly");
   assembly.allowOnly({"match_by", "tolerance_ms", "timeout_ms"});
@@ -170,6 +207,20 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
     } catch (const InputError& e) {
       throw InputError(file + ": source.dataset.path: " + e.what());
     }
+  } else if (c.source_type == "sim") {
+    if (!c.calibration.empty())
+      top.fail("calibration", "not used with source.type sim (the rig is source.sim.rig: a preset or a Kalibr file)");
+    Rig full;
+    try {
+      full = sim::loadRig(c.sim.rig);
+    } catch (const InputError& e) {
+      throw InputError(file + ": source.sim.rig: " + e.what());
+    }
+    try {
+      c.rig = c.sim.cameras.empty() ? full : full.subset(c.sim.cameras);
+    } catch (const InputError& e) {
+      throw InputError(file + ": source.sim.cameras: " + e.what());
+    }
   } else {
     if (c.calibration.empty()) top.fail("calibration", "missing (required for source.type aravis)");
     try {
@@ -186,6 +237,10 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
                                 std::to_string(c.rig.size()) + " cameras");
   validatePipelineConfig(c.slam, file, c.rig);
   return c;
+}
+
+bool exitsAtEnd(const DaemonConfig& c) {
+  return (c.source_type == "dataset" && c.dataset.at_end == "exit") || (c.source_type == "sim" && c.sim.at_end == "exit");
 }
 
 DaemonConfig loadDaemonConfig(const std::string& path) {
@@ -208,6 +263,17 @@ std::string effectiveDaemonConfig(const DaemonConfig& c) {
     e << YAML::Key << "preload" << YAML::Value << d.preload;
     e << YAML::Key << "max_preload_frames" << YAML::Value << d.max_preload_frames;
     e << YAML::Key << "cameras" << YAML::Value << YAML::Flow << d.cameras;
+    e << YAML::EndMap;
+  } else if (c.source_type == "sim") {
+    const auto& m = c.sim;
+    e << YAML::Key << "sim" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "rig" << YAML::Value << m.rig << YAML::Key << "world" << YAML::Value << m.world;
+    e << YAML::Key << "trajectory" << YAML::Value << m.trajectory << YAML::Key << "rate_hz" << YAML::Value << m.rate_hz;
+    e << YAML::Key << "frames" << YAML::Value << m.frames << YAML::Key << "seed" << YAML::Value << m.seed;
+    e << YAML::Key << "pace" << YAML::Value << m.pace << YAML::Key << "at_end" << YAML::Value << m.at_end;
+    e << YAML::Key << "anti_aliasing" << YAML::Value << m.anti_aliasing;
+    e << YAML::Key << "render_threads" << YAML::Value << m.render_threads;
+    e << YAML::Key << "cameras" << YAML::Value << YAML::Flow << m.cameras;
     e << YAML::EndMap;
   } else {
     const auto& a = c.aravis;

@@ -21,6 +21,21 @@ struct DatasetSourceConfig {
   std::vector<int> cameras;       // calibration indices to use (empty = all)
 };
 
+// Live rendering with the simulator (mcslam_sim): frames are rendered as they are due.
+struct SimSourceConfig {
+  std::string rig = "isec";           // preset (isec, stereo, mono, ring8) or Kalibr camchain file
+  std::string world = "indoor";       // indoor | corridor | courtyard
+  std::string trajectory = "ground";  // ground | handheld | file:PATH (TUM)
+  double rate_hz = 10;                // simulated frame rate: the motion and the capture stamps
+  int frames = 0;                     // 0: as many as the trajectory lasts
+  uint64_t seed = 1;
+  std::string pace = "fastest";       // fastest (lossless, as the pipeline takes frames) | realtime
+  std::string at_end = "loop";        // exit | loop | idle
+  bool anti_aliasing = true;          // false: one ray per pixel, cheaper
+  int render_threads = 0;             // 0: one per core
+  std::vector<int> cameras;           // rig indices to render (empty = all)
+};
+
 struct AravisCameraConfig {
   std::string id;              // serial number, device ID or IP address
   double exposure_us = 0;      // 0 = leave as configured on the camera
@@ -85,9 +100,10 @@ struct DaemonConfig {
   std::string log_level = "info";
   double status_interval_s = 1.0;
   double warmup_frames = 50;  // allocations are counted after this many processed frames
-  std::string source_type;   // dataset | aravis
+  std::string source_type;   // dataset | aravis | sim
   std::string calibration;   // Kalibr camchain; optional for a dataset (it has its own)
   DatasetSourceConfig dataset;
+  SimSourceConfig sim;
   AravisSourceConfig aravis;
   TriggerConfig trigger;
   AssemblyConfig assembly;
@@ -96,8 +112,11 @@ struct DaemonConfig {
   OutputConfig output;
   RealtimeConfig realtime;
   YAML::Node slam;  // handed to the pipeline factory
-  Rig rig;          // resolved: calibration file, or the dataset's own
+  Rig rig;          // resolved: calibration file, the dataset's own, or the simulated rig's cameras
 };
+
+// A finite source that stops the daemon when it has delivered its last frame (at_end: exit).
+bool exitsAtEnd(const DaemonConfig& config);
 
 // Parses and validates everything that needs no device (the rig is loaded; the dataset is opened
 // only to read its rig and count). Throws InputError.

@@ -96,8 +96,8 @@ int runDaemon(const DaemonConfig& config) {
       processed_at_status = s.processed;
       last_status = now;
     }
-    if (config.source_type == "dataset" && config.dataset.at_end == "exit" && daemon.drained()) {
-      spdlog::info("replay finished: stopping");
+    if (exitsAtEnd(config) && daemon.drained()) {
+      spdlog::info("source finished (at_end: exit): stopping");
       break;
     }
   }
@@ -111,7 +111,6 @@ int runDaemon(const DaemonConfig& config) {
       "{} camera images dropped, {} partial, {} bad, {} allocations in {} frames after warm-up (process total {})",
       s.processed, s.published, s.trajectory_poses, daemon.trajectoryPath(), s.rig_drops, s.camera_drops,
       s.partial_frames, s.bad_frames, s.allocations_after_warmup, s.frames_after_warmup, alloc::totalCount());
-  spdlog::info("refined extrinsics: the pipeline provides none yet; nothing written");
   if (!clean) spdlog::error("the pipeline did not finish its frame within the grace period");
   return clean ? 0 : 1;
 }

@@ -103,3 +103,37 @@ TEST_F(ConfigTest, InconsistentCombinationsAreRefused) {
 TEST_F(ConfigTest, MalformedYamlIsReportedWithTheFile) {
   expectError("source: {type: dataset\n", {"not valid YAML"});
 }
+
+TEST_F(ConfigTest, SimSourceGetsThePresetsCamerasAndDefaults) {
+  const DaemonConfig c = parseDaemonConfig(
+      "source:\n  type: sim\n  sim:\n    rig: isec\n    cameras: [0, 1, 2, 3, 4]\n    world: corridor\n", dir_.file("sim.yaml"));
+  EXPECT_EQ(c.source_type, "sim");
+  EXPECT_EQ(c.rig.size(), 5);
+  EXPECT_EQ(c.rig.model(0).width(), 720);
+  EXPECT_EQ(c.sim.world, "corridor");
+  EXPECT_EQ(c.sim.pace, "fastest");
+  EXPECT_EQ(c.sim.at_end, "loop");
+  EXPECT_TRUE(exitsAtEnd(parseDaemonConfig("source:\n  type: sim\n  sim: {rig: stereo, at_end: exit}\n", dir_.file("s.yaml"))));
+  const std::string effective = effectiveDaemonConfig(c);
+  EXPECT_NE(effective.find("world: corridor"), std::string::npos) << effective;
+  EXPECT_NE(effective.find("cameras: [0, 1, 2, 3, 4]"), std::string::npos) << effective;
+  // A rig file is taken relative to the configuration, like every path.
+  const DaemonConfig f = parseDaemonConfig("source:\n  type: sim\n  sim: {rig: camchain.yaml}\n", dir_.file("f.yaml"));
+  EXPECT_EQ(f.sim.rig, calib_);
+  EXPECT_EQ(f.rig.size(), 3);
+}
+
+TEST_F(ConfigTest, SimSourceErrorsNameTheKeyAndTheValue) {
+  const std::string sim = "source:\n  type: sim\n  sim:\n";
+  expectError(sim + "    wrold: indoor\n", {"source.sim.wrold", "unknown key"});
+  expectError(sim + "    world: moon\n", {"source.sim.world", "'moon'", "indoor"});
+  expectError(sim + "    trajectory: flying\n", {"source.sim.trajectory", "'flying'"});
+  expectError(sim + "    rig: octopus\n", {"source.sim.rig", "octopus"});
+  expectError(sim + "    rig: stereo\n    cameras: [0, 7]\n", {"source.sim.cameras", "7"});
+  expectError(sim + "    rate_hz: 0\n", {"source.sim.rate_hz"});
+  expectError(sim + "    pace: warp\n", {"source.sim.pace", "'warp'"});
+  expectError(sim + "    frames: -3\n", {"source.sim.frames"});
+  expectError("calibration: " + calib_ + "\n" + sim + "    rig: stereo\n", {"calibration", "source.sim.rig"});
+  expectError(sim + "    rig: stereo\ntrigger:\n  mode: gpio\n  gpio_chip: gpiochip0\n  gpio_line: 1\n", {"trigger", "gpio"});
+  expectError("source:\n  type: sim\n  dataset: {path: x}\n", {"source.dataset", "source.type is sim"});
+}

@@ -1,6 +1,8 @@
-// mcslamd as a process, the way systemd runs it: READY=1 and WATCHDOG=1 arrive on a test NOTIFY_SOCKET,
-// another process (this test) reads the poses over shared memory and over UDP and they equal each other
-// and the trajectory file the daemon writes; SIGTERM ends it cleanly with the trajectory complete.
+// mcslamd as a process, the way systemd runs it, with the real pipeline on a rendered simulator dataset:
+// READY=1 and WATCHDOG=1 arrive on a test NOTIFY_SOCKET, another process (this test) reads the poses
+// over shared memory and over UDP and they equal each other and the trajectory file the daemon writes;
+// SIGTERM ends it cleanly within 2 s with the trajectory complete and the refined extrinsics written; the
+// trajectory is within centimetres of the simulator's ground truth.
 // Also: no WATCHDOG=1 while no frame is processed, and a bad configuration ends start-up with one
 // message naming the key (exit status 2).
 #include <fcntl.h>
@@ -20,7 +22,11 @@
 #include <thread>
 
 #include "daemon_fixture.hpp"
+#include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/dataset/trajectory.hpp"
+#include "mcslam/eval/trajectory_metrics.hpp"
 #include "mcslam/pose_shm.hpp"
+#include "sim_dataset_fixture.hpp"
 #include "test_support.hpp"
 
 using namespace mcslam;
@@ -118,6 +124,34 @@ bool waitFor(Pred pred, int seconds = 60) {
   return true;
 }
 
+struct TumRow {
+  std::string stamp;           // as written
+  std::vector<double> values;  // tx ty tz qx qy qz qw, parsed with strtod (exact round trip)
+};
+
+std::vector<TumRow> readTumRows(const std::string& path) {
+  std::vector<TumRow> rows;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    TumRow row;
+    std::string token;
+    s >> row.stamp;
+    while (s >> token) row.values.push_back(std::strtod(token.c_str(), nullptr));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string tumStamp(int64_t ns) {
+  char b[32];
+  std::snprintf(b, sizeof(b), "%lld.%09lld", static_cast<long long>(ns / 1000000000),
+                static_cast<long long>(ns % 1000000000));
+  return b;
+}
+
 std::string readAll(const std::string& path) {
   std::ifstream in(path);
   std::stringstream s;
@@ -127,10 +161,13 @@ std::string readAll(const std::string& path) {
 
 }  // namespace
 
-TEST(McslamdProcess, ReplayPublishesOverShmAndUdpEqualToTheTrajectoryAndStopsCleanlyOnSigterm) {
+// The whole chain with the real pipeline: a rendered 5-camera sequence replayed losslessly and looped,
+// SIGTERM in the second pass (the pipeline is mid-frame), then every record compared across the three
+// outputs and the first pass's trajectory against the simulator's ground truth.
+TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsCleanlyOnSigterm) {
+  const std::string data = test::cachedSimDataset();
+  const uint64_t frames = test::kSimDatasetFrames;
   test::TempDir dir("mcslamd");
-  const int frames = 60;
-  const std::string data = test::writeSmallDataset(dir.file("data"), 3, frames);
   NotifyListener notify(dir.file("notify.sock"));
   ASSERT_TRUE(notify.ok());
   const int rx = ::socket(AF_INET, SOCK_DGRAM, 0);
@@ -145,12 +182,12 @@ TEST(McslamdProcess, ReplayPublishesOverShmAndUdpEqualToTheTrajectoryAndStopsCle
 
   const std::string shm = "/mcslam-test-proc-" + std::to_string(getpid());
   const std::string config = test::writeFile(dir.file("mcslamd.yaml"),
-      "log_level: debug\nstatus_interval_s: 0.2\n"
-      "source:\n  type: dataset\n  dataset:\n    path: data\n    rate: fastest\n    at_end: idle\n"
+      "log_level: debug\nstatus_interval_s: 0.2\nwarmup_frames: 20\n"
+      "source:\n  type: dataset\n  dataset:\n    path: " + data + "\n    rate: fastest\n    at_end: loop\n"
       "publish:\n  shm:\n    name: " + shm + "\n    mode: \"0640\"\n    ring_length: 256\n"
       "  udp:\n    destinations: [\"127.0.0.1:" + std::to_string(ntohs(a.sin_port)) + "\"]\n"
-      "output:\n  directory: out\n");
-  std::filesystem::create_directories(dir.file("out"));
+      "output:\n  directory: out\n  extrinsics: refined/extrinsics.yaml\n");
+  std::filesystem::create_directories(dir.file("out/refined"));
   const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "400000", dir.file("log.txt"));
   ASSERT_GT(pid, 0);
 
@@ -159,28 +196,30 @@ TEST(McslamdProcess, ReplayPublishesOverShmAndUdpEqualToTheTrajectoryAndStopsCle
   std::string error;
   ASSERT_TRUE(reader.open(shm, &error)) << error;
   EXPECT_EQ(reader.writerPid(), pid);
-  ASSERT_TRUE(waitFor([&] { return reader.published() >= static_cast<uint64_t>(frames); }))
-      << readAll(dir.file("log.txt"));
-  std::vector<pose::PoseRecord> from_shm;
-  for (uint64_t s = 1; s <= reader.published(); ++s) {
-    pose::PoseRecord r;
-    ASSERT_EQ(reader.readSequence(s, r), pose::ReadStatus::Ok);
-    from_shm.push_back(r);
-  }
+  ASSERT_TRUE(waitFor([&] { return reader.published() >= frames + 3; }, 120)) << readAll(dir.file("log.txt"));
   ASSERT_TRUE(waitFor([&] { return notify.count("WATCHDOG=1") >= 1 && notify.count("STATUS=") >= 1; }));
-  EXPECT_NE(notify.last("STATUS=").find("Hz"), std::string::npos) << notify.last("STATUS=");
+  EXPECT_NE(notify.last("STATUS=").find("tracking"), std::string::npos) << notify.last("STATUS=");
 
   const auto t0 = Clock::now();
   ASSERT_EQ(::kill(pid, SIGTERM), 0);
   const int status = waitExit(pid, 20);
   const double stop_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  std::printf("mcslamd stopped %.3f s after SIGTERM\n", stop_s);  // reported, not asserted (no timing asserts)
   const std::string log = readAll(dir.file("log.txt"));
   EXPECT_EQ(status, 0) << log;
+  EXPECT_LT(stop_s, 2.0) << "the issue's bound from SIGTERM to exit";  // the one timed assertion (issue mcslamd)
   EXPECT_FALSE(reader.writerRunning());
   EXPECT_EQ(notify.count("STOPPING=1"), 1);
   EXPECT_NE(log.find("SIGTERM: stopping"), std::string::npos) << log;
 
+  // The segment stays mapped after the daemon unlinked it: read every record it published.
+  const uint64_t published = reader.published();
+  ASSERT_LE(published, 256u) << "ring_length must hold the whole run";
+  std::vector<pose::PoseRecord> from_shm;
+  for (uint64_t seq = 1; seq <= published; ++seq) {
+    pose::PoseRecord r;
+    ASSERT_EQ(reader.readSequence(seq, r), pose::ReadStatus::Ok);
+    from_shm.push_back(r);
+  }
   std::vector<pose::PoseRecord> from_udp;
   uint8_t buf[512];
   for (;;) {
@@ -191,34 +230,54 @@ TEST(McslamdProcess, ReplayPublishesOverShmAndUdpEqualToTheTrajectoryAndStopsCle
     from_udp.push_back(r);
   }
   ::close(rx);
-
-  ASSERT_EQ(from_shm.size(), static_cast<std::size_t>(frames));
   ASSERT_EQ(from_udp.size(), from_shm.size());
-  std::vector<std::string> expected_lines;
+  ASSERT_GT(from_shm.size(), frames);
+
+  // The trajectory: exactly the valid records, in order, numbers parsing back to the published doubles.
+  const auto rows = readTumRows(dir.file("out/trajectory.tum"));
+  std::size_t row = 0;
+  Trajectory first_pass;
   for (std::size_t i = 0; i < from_shm.size(); ++i) {
+    const pose::PoseRecord& r = from_shm[i];
     uint8_t x[pose::kPacketSize], y[pose::kPacketSize];
-    pose::encodePacket(from_shm[i], x);
+    pose::encodePacket(r, x);
     pose::encodePacket(from_udp[i], y);
-    EXPECT_EQ(std::memcmp(x, y, sizeof(x)), 0) << "record " << i;
-    EXPECT_EQ(from_shm[i].sequence, i + 1);
-    EXPECT_EQ(from_shm[i].frame_sequence, i);  // fastest replay is lossless
-    if (!from_shm[i].valid()) continue;
-    std::ostringstream line;
-    const int64_t t = from_shm[i].capture_time_ns;
-    char stamp[32];
-    std::snprintf(stamp, sizeof(stamp), "%lld.%09lld", static_cast<long long>(t / 1000000000),
-                  static_cast<long long>(t % 1000000000));
-    expected_lines.push_back(stamp);
+    EXPECT_EQ(std::memcmp(x, y, sizeof(x)), 0) << "record " << i << " differs between shm and UDP";
+    EXPECT_EQ(r.sequence, i + 1);
+    EXPECT_EQ(r.frame_sequence, i);  // fastest replay is lossless
+    if (!r.valid()) continue;
+    ASSERT_LT(row, rows.size()) << "valid record " << i << " missing in the trajectory";
+    EXPECT_EQ(rows[row].stamp, tumStamp(r.capture_time_ns)) << "row " << row;
+    ASSERT_EQ(rows[row].values.size(), 7u);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(rows[row].values[k], r.position[k]) << "row " << row;
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(rows[row].values[3 + k], r.orientation[k]) << "row " << row;
+    ++row;
+    if (r.frame_sequence < frames) {
+      const Eigen::Quaterniond q(r.orientation[3], r.orientation[0], r.orientation[1], r.orientation[2]);
+      first_pass.push_back({r.capture_time_ns, SE3(q.toRotationMatrix(), Vec3(r.position[0], r.position[1], r.position[2]))});
+    }
   }
-  // The trajectory holds exactly the valid published poses (none with today's stub pipeline, all of
-  // them once the odometry initializes), complete after SIGTERM.
-  std::ifstream traj(dir.file("out/trajectory.tum"));
-  ASSERT_TRUE(traj.good());
-  std::vector<std::string> stamps;
-  std::string line;
-  while (std::getline(traj, line))
-    if (!line.empty() && line[0] != '#') stamps.push_back(line.substr(0, line.find(' ')));
-  EXPECT_EQ(stamps, expected_lines);
+  EXPECT_EQ(rows.size(), row) << "the trajectory holds a line that was never published";
+
+  // The poses are right: the first pass against the simulator's ground truth (SE(3)-aligned).
+  ASSERT_GE(first_pass.size(), frames * 9 / 10) << "the pipeline initialized late or lost track";
+  const ApeResult ape = computeApe(readTumTrajectory(data + "/groundtruth.txt"), first_pass, EvalOptions{});
+  std::printf("ATE rmse %.4f m over %zu poses, stop %.3f s after SIGTERM\n", ape.stats.rmse, ape.errors.size(), stop_s);
+  EXPECT_EQ(ape.errors.size(), first_pass.size());
+  EXPECT_LT(ape.stats.rmse, 0.03);
+  EXPECT_LT(ape.stats.max, 0.08);
+
+  // The refined extrinsics, written at stop: a Kalibr camchain of the same rig, close to the calibration.
+  ASSERT_NE(log.find("refined extrinsics written"), std::string::npos) << log;
+  const Rig written = loadKalibrRig(dir.file("out/refined/extrinsics.yaml"));
+  const Rig calibrated = loadKalibrRig(data + "/camchain.yaml");
+  ASSERT_EQ(written.size(), calibrated.size());
+  for (int c = 0; c < written.size(); ++c) {
+    const SE3 d = calibrated.T_b_c(c).inverse() * written.T_b_c(c);
+    EXPECT_LT(d.t.norm(), 0.02) << "cam" << c;
+    EXPECT_LT(so3Log(d.R).norm(), 1.0 * M_PI / 180) << "cam" << c;
+    EXPECT_EQ(written.model(c).width(), calibrated.model(c).width());
+  }
 }
 
 TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
@@ -263,5 +322,13 @@ TEST(McslamdProcess, CheckConfigPrintsTheEffectiveConfiguration) {
   ASSERT_EQ(test::runCommand(test::binPath("mcslamd") + " --check-config " + config, &out), 0) << out;
   for (const char* key : {"rig_ring_slots: 2", "pose_ring_slots: 64", "name: /mcslam_pose", "mode: free_running",
                           "slam:", "rig: 2 camera"})
+    EXPECT_NE(out.find(key), std::string::npos) << key << " missing in:\n" << out;
+}
+
+TEST(McslamdProcess, ShippedSimConfigChecksOutWithoutADataset) {
+  const std::string config = test::dataPath("../../config/mcslamd-sim.yaml");
+  std::string out;
+  ASSERT_EQ(test::runCommand(test::binPath("mcslamd") + " --check-config " + config, &out), 0) << out;
+  for (const char* key : {"type: sim", "world: indoor", "cameras: [0, 1, 2, 3, 4]", "rig: 5 camera"})
     EXPECT_NE(out.find(key), std::string::npos) << key << " missing in:\n" << out;
 }

@@ -96,10 +96,12 @@ def main():
         shm = "/mcslam-rss-%d" % os.getpid()
         config = os.path.join(work, "mcslamd.yaml")
         with open(config, "w") as f:
-            f.write("log_level: warn\nsource:\n  type: dataset\n  dataset:\n    path: %s\n    rate: %s\n"
-                    "    at_end: loop\npublish:\n  shm:\n    name: %s\noutput:\n  directory: %s\nslam: %s\n"
+            f.write("log_level: info\nsource:\n  type: dataset\n  dataset:\n    path: %s\n    rate: %s\n"
+                    "    at_end: loop\nstatus_interval_s: 5\npublish:\n  shm:\n    name: %s\noutput:\n  directory: %s\nslam: %s\n"
                     % (data, args.rate, shm, work, args.slam))
-        proc = subprocess.Popen([args.mcslamd, "--config", config], stdout=subprocess.DEVNULL)
+        log_path = os.path.join(work, "mcslamd.log")
+        log = open(log_path, "w")
+        proc = subprocess.Popen([args.mcslamd, "--config", config], stdout=log, stderr=subprocess.STDOUT)
         samples = []
         start = time.time()
         while True:
@@ -114,6 +116,14 @@ def main():
                 break
         proc.send_signal(signal.SIGTERM)
         proc.wait(timeout=30)
+        log.close()
+        with open(log_path) as f:  # the daemon's totals at stop (allocations after warm-up included)
+            lines = f.read().splitlines()
+        print("tracking lost %d times; last status: %s" % (
+            sum("tracking lost" in l for l in lines), next((l for l in reversed(lines) if "allocs/frame" in l), "-")))
+        for line in lines:
+            if "stopped:" in line:
+                print(line)
         after = [s for s in samples if s[1] >= args.warmup_frames] or samples
         first, last = after[0], samples[-1]
         peak = max(s[2] for s in samples)

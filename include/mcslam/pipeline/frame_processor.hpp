@@ -4,6 +4,7 @@
 // their memory at construction; process() does not touch the heap after warm-up.
 #include <cstdint>
 
+#include "mcslam/calib/rig.hpp"
 #include "mcslam/core/image.hpp"
 #include "mcslam/core/se3.hpp"
 #include "mcslam/core/time.hpp"
@@ -49,6 +50,13 @@ class FrameProcessor {
   virtual ~FrameProcessor() = default;
   // Processes one rig frame and writes its pose. Never throws on bad image content.
   virtual void process(const RigFrameView& frame, PoseEstimate& out) = 0;
+  // The rig with the extrinsics as the pipeline has refined them online, for writing out at the end of a
+  // run (copies, so it may allocate; never call it concurrently with process()). False when the pipeline
+  // has none to hand over.
+  virtual bool refinedRig(Rig& out) const {
+    (void)out;
+    return false;
+  }
 };
 
 }  // namespace mcslam

@@ -25,6 +25,11 @@ class SlamPipeline final : public FrameProcessor {
   const FrontEnd& frontEnd() const { return front_end_; }
   const Odometry& odometry() const { return odometry_; }
   Rig refinedRig() const { return odometry_.refinedRig(); }
+  // The back-end's current extrinsics (the calibration's when refinement is off).
+  bool refinedRig(Rig& out) const override {
+    out = odometry_.refinedRig();
+    return true;
+  }
   const PipelineConfig& config() const { return config_; }
 
  private:
