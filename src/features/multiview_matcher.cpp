@@ -62,7 +62,10 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
   order_.resize(matches_.size());
   best_for_b_.resize(capacity_);
   best_dist_for_b_.resize(capacity_);
+  second_dist_for_b_.resize(capacity_);
   epipolar_normals_.resize(capacity_);
+  candidate_b_.resize(capacity_);
+  candidate_dist_.resize(capacity_);
   parent_.resize(static_cast<std::size_t>(n) * capacity_);
   camera_mask_.resize(parent_.size());
   component_of_root_.resize(parent_.size());
@@ -128,6 +131,7 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
 
   std::fill(best_for_b_.begin(), best_for_b_.begin() + sj.count, -1);
   std::fill(best_dist_for_b_.begin(), best_dist_for_b_.begin() + sj.count, int16_t{257});
+  std::fill(second_dist_for_b_.begin(), second_dist_for_b_.begin() + sj.count, int16_t{257});
   const int first_match = match_count_;
 
   for (int a = 0; a < si.count; ++a) {
@@ -139,7 +143,7 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
     n /= nn;
     const Descriptor& da = si.descriptors[a];
     const int oa = si.keypoints[a].octave;
-    int best = 257, second = 257, best_b = -1;
+    int best = 257, best_b = -1, candidates = 0;
     for (const int32_t cell : overlap_.candidates(i, j, cell_of_[i][a])) {
       for (int32_t idx = cell_start_[j][cell]; idx < cell_start_[j][cell + 1]; ++idx) {
         const int b = cell_items_[j][idx];
@@ -148,29 +152,63 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
         if (std::abs(oa - ob) > options_.max_octave_difference) continue;
         if (std::abs(n.dot(f.bearings[j][b])) > gate[std::min(ob, kMaxOctaves - 1)]) continue;
         const int d = hammingDistance(da, sj.descriptors[b]);
+        candidate_b_[candidates] = b;
+        candidate_dist_[candidates++] = static_cast<int16_t>(d);
         if (d < best) {
-          second = best;
           best = d;
           best_b = b;
-        } else if (d < second) {
-          second = d;
         }
-        if (d < best_dist_for_b_[b]) {
-          best_dist_for_b_[b] = static_cast<int16_t>(d);
-          best_for_b_[b] = a;
-        }
+        noteForB(si, b, a, d);
       }
     }
-    if (best_b < 0 || best > options_.max_hamming || !(best < options_.ratio * second)) continue;
+    if (best_b < 0 || best > options_.max_hamming) continue;
+    // Ratio test against the best candidate elsewhere on the epipolar curve. The pyramid detects one corner
+    // at several octaves with near-identical descriptors; such a copy of the best is no rival.
+    const Keypoint& kb = sj.keypoints[best_b];
+    const double same_px = options_.duplicate_px * std::pow(options_.octave_scale, kb.octave);
+    int second = 257;
+    for (int c = 0; c < candidates; ++c) {
+      const Keypoint& kc = sj.keypoints[candidate_b_[c]];
+      const double dx = kc.x - kb.x, dy = kc.y - kb.y;
+      if (candidate_dist_[c] < second && dx * dx + dy * dy > same_px * same_px) second = candidate_dist_[c];
+    }
+    if (!(best < options_.ratio * second)) continue;
     matches_[match_count_++] = Match{static_cast<int16_t>(i), static_cast<int16_t>(j), a, best_b,
                                      static_cast<int16_t>(best)};
   }
-  // Keep only mutual best matches: b's best keypoint of camera i must be a.
+  // Keep only mutual best matches that pass the ratio test both ways: b's best keypoint of camera i must be a,
+  // and clearly better than any other corner of camera i on the same epipolar curve. One way is not enough:
+  // on periodic texture (books, bricks, tiles) the true partner of a may be missing in j while a's repetitions
+  // in camera i all compete for the same b, and along a linear camera array an alias stays consistent in all views.
   int kept = first_match;
   for (int m = first_match; m < match_count_; ++m) {
-    if (best_for_b_[matches_[m].kp_b] == matches_[m].kp_a) matches_[kept++] = matches_[m];
+    const int b = matches_[m].kp_b;
+    if (best_for_b_[b] == matches_[m].kp_a && best_dist_for_b_[b] < options_.ratio * second_dist_for_b_[b]) {
+      matches_[kept++] = matches_[m];
+    }
   }
   match_count_ = kept;
+}
+
+// Best and second best keypoint of camera i for keypoint b of camera j, the second ignoring copies of the best
+// (the same corner detected at another octave).
+void MultiViewMatcher::noteForB(const FeatureSet& si, int b, int a, int d) {
+  const int best_a = best_for_b_[b];
+  bool copy_of_best = false;
+  if (best_a >= 0) {
+    const Keypoint& ka = si.keypoints[a];
+    const Keypoint& kb = si.keypoints[best_a];
+    const double same_px = options_.duplicate_px * std::pow(options_.octave_scale, std::max(ka.octave, kb.octave));
+    const double dx = ka.x - kb.x, dy = ka.y - kb.y;
+    copy_of_best = dx * dx + dy * dy <= same_px * same_px;
+  }
+  if (d < best_dist_for_b_[b]) {
+    if (!copy_of_best) second_dist_for_b_[b] = best_dist_for_b_[b];
+    best_dist_for_b_[b] = static_cast<int16_t>(d);
+    best_for_b_[b] = a;
+  } else if (d < second_dist_for_b_[b] && !copy_of_best) {
+    second_dist_for_b_[b] = static_cast<int16_t>(d);
+  }
 }
 
 int MultiViewMatcher::find(int node) {

@@ -19,6 +19,7 @@ struct MultiViewOptions {
   double epipolar_px = 2.0;         // gate, in pixels at octave 0 (scaled by the keypoint's octave sigma)
   float octave_scale = 1.2f;        // pyramid scale factor: sigma = scale^octave
   int max_octave_difference = 2;    // scale consistency between the two keypoints
+  double duplicate_px = 3.0;        // candidates this close to the best (x octave sigma) are the same corner
   TriangulationOptions triangulation;  // max_relative_depth_sigma decides which points are metric
 
   MultiViewOptions() { triangulation.max_relative_depth_sigma = 0.01; }
@@ -51,6 +52,7 @@ class MultiViewMatcher {
   void computeBearings(FrameFeatures& f);
   void bucketKeypoints(const FrameFeatures& f);
   void matchPair(const FrameFeatures& f, int i, int j);
+  void noteForB(const FeatureSet& si, int b, int a, int d);
   void mergeTracks(FrameFeatures& f);
   void finishTrack(FrameFeatures& f, int first, int size);
   int find(int node);
@@ -71,6 +73,7 @@ class MultiViewMatcher {
   int match_count_ = 0;
   std::vector<int32_t> best_for_b_;      // per keypoint of camera j: best keypoint of camera i
   std::vector<int16_t> best_dist_for_b_;
+  std::vector<int16_t> second_dist_for_b_;  // ignoring copies of the best at other octaves
   std::vector<int32_t> parent_;          // union-find over (camera, keypoint) nodes
   std::vector<uint64_t> camera_mask_;    // per root: cameras already in the component
   std::vector<int32_t> order_;           // matches sorted by distance
@@ -80,6 +83,8 @@ class MultiViewMatcher {
   std::vector<int32_t> members_;         // nodes grouped by component
   std::vector<TriangulationObservation> scratch_obs_;
   std::vector<Vec3> epipolar_normals_;   // per keypoint of camera i, in camera j's frame
+  std::vector<int32_t> candidate_b_;     // epipolar-consistent candidates of the current keypoint
+  std::vector<int16_t> candidate_dist_;
 };
 
 }  // namespace mcslam
