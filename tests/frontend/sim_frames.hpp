@@ -1,0 +1,32 @@
+#pragma once
+// Rendered rig frames for front-end tests: one Simulation per (rig, world) per process, built on first
+// use (world construction takes seconds), and frames rendered with their depth along the optical axis.
+#include <string>
+#include <vector>
+
+#include "mcslam/core/image.hpp"
+#include "mcslam/pipeline/frame_processor.hpp"
+#include "mcslam/sim/simulation.hpp"
+
+namespace mcslam::test {
+
+// The shared simulation of a preset rig in a world (seed 1, ground trajectory, 10 Hz).
+sim::Simulation& sharedSimulation(const std::string& rig, const std::string& world);
+
+// One rig frame: images and depth of the rendered cameras (the others stay empty).
+struct RenderedFrame {
+  std::vector<Image> images;
+  std::vector<sim::DepthImage> depths;
+  std::vector<ImageView> views;
+  std::unique_ptr<bool[]> present;
+
+  RigFrameView view() const;
+};
+
+// Renders `cameras` of frame `frame` (depth included).
+RenderedFrame renderFrame(sim::Simulation& sim, int frame, const std::vector<int>& cameras);
+
+// Depth along camera's optical axis at the pixel nearest (x, y); 0 outside or where nothing was hit.
+double depthAt(const sim::DepthImage& depth, double x, double y);
+
+}  // namespace mcslam::test
