@@ -16,9 +16,9 @@
 #include "daemon/daemon.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon_fixture.hpp"
+#include "sim_dataset_fixture.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
 #include "mcslam/pose_shm.hpp"
-#include "mcslam/sim/simulation.hpp"
 #include "test_support.hpp"
 
 using namespace mcslam;
@@ -277,11 +277,13 @@ TEST_F(DaemonTest, NoDaemonThreadAllocatesPerFrameAfterWarmup) {
 }
 
 TEST_F(DaemonTest, SimSourceDeliversTheSimulatorsFramesWholeAndInOrder) {
-  // Stereo, one ray per pixel: cheap to render twice (by the source, then here for comparison).
+  // The same simulation as the cached dataset (isec, indoor, ground, 10 Hz, seed 1), two of its cameras
+  // in another order: the rendered frames must equal the dataset's images byte for byte.
+  const std::string data = test::cachedSimDataset();
+  const int frames = 4;
   const DaemonConfig c = parseDaemonConfig(
-      "source:\n  type: sim\n  sim:\n    rig: isec\n    cameras: [3, 1]\n    frames: 8\n    at_end: exit\n"
-      "    anti_aliasing: false\n    seed: 4\npublish:\n  shm:\n    enabled: false\n"
-      "output:\n  directory: " + dir_.path().string() + "\n",
+      "source:\n  type: sim\n  sim:\n    rig: isec\n    cameras: [3, 1]\n    frames: 4\n    at_end: exit\n"
+      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " + dir_.path().string() + "\n",
       dir_.file("sim.yaml"));
   std::vector<RecordingProcessor::Seen> seen;
   {
@@ -290,25 +292,21 @@ TEST_F(DaemonTest, SimSourceDeliversTheSimulatorsFramesWholeAndInOrder) {
     ASSERT_TRUE(waitFor([&] { return d.drained(); }, 120));
     ASSERT_TRUE(d.stop());
     const DaemonStats st = d.stats();
-    EXPECT_EQ(st.rig_frames, 8u);  // at_end exit: the sequence, once
+    EXPECT_EQ(st.rig_frames, 4u);      // at_end exit: the sequence, once
     EXPECT_EQ(st.partial_frames, 0u);  // all cameras rendered before any is published
     EXPECT_EQ(st.rig_drops, 0u);       // pace fastest is lossless
   }
-  sim::SimulationConfig cfg;
-  cfg.frames = 8;
-  cfg.seed = 4;
-  cfg.render.anti_aliasing = false;
-  sim::Simulation simulation(cfg);
-  ASSERT_EQ(seen.size(), 8u);
-  Image img;
-  for (int i = 0; i < 8; ++i) {
-    EXPECT_EQ(seen[i].t, simulation.frameStamp(i));
+  DatasetOptions options;
+  options.cameras = {3, 1};
+  const Dataset dataset = Dataset::open(data, options);
+  ASSERT_EQ(seen.size(), static_cast<std::size_t>(frames));
+  std::vector<Image> images;
+  std::vector<bool> present;
+  for (int i = 0; i < frames; ++i) {
+    EXPECT_EQ(seen[i].t, dataset.frames()[i].t);
     EXPECT_EQ(seen[i].sequence, static_cast<uint64_t>(i));
     ASSERT_EQ(seen[i].hashes.size(), 2u);
-    const int sim_cameras[2] = {3, 1};  // daemon camera c is the preset's camera cameras[c]
-    for (int k = 0; k < 2; ++k) {
-      simulation.render(i, sim_cameras[k], img);
-      EXPECT_EQ(seen[i].hashes[k], imageHash(img.view())) << "frame " << i << " camera " << k;
-    }
+    dataset.loadImages(i, images, present, nullptr);
+    for (int k = 0; k < 2; ++k) EXPECT_EQ(seen[i].hashes[k], imageHash(images[k].view())) << "frame " << i << " camera " << k;
   }
 }
