@@ -60,6 +60,7 @@ void Odometry::resetMap() {
   mapper_->reset();
   initializer_->reset();
   last_tracked_count_ = 0;
+  last_coarse_inliers_ = 0;
   have_velocity_ = false;
 }
 
@@ -189,6 +190,7 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   last_keyframe_tracked_ = countKeyframeLandmarks(kf_new);
   // Track from the landmarks of the new keyframe.
   last_tracked_count_ = 0;
+  last_coarse_inliers_ = 0;
   const Keyframe& kf = map_.keyframe(kf_new);
   for (int c = 0; c < kf.features.cameras(); ++c) {
     for (int k = 0; k < kf.features.sets[c].count; ++k) {
@@ -225,41 +227,49 @@ Odometry::TrackResult Odometry::track(const FrameFeatures& frame, uint64_t frame
   params.scale_factor = options_.scale_factor;
   params.levels = options_.levels;
 
-  // 1. The landmarks tracked in the previous frame, around the motion-model prediction; a wider
-  //    search over the whole local map when that finds too little (sudden turns, stops).
+  // Coarse pose, in up to three attempts of growing cost, until one is strong (a fair share of the previous
+  // frame's inliers; a weak consensus is often a wrong pose after a jolt the motion model did not predict):
+  //   0. the landmarks tracked in the previous frame, around the motion-model prediction;
+  //   1. the whole local map with a wide radius (sudden turns, stops);
+  //   2. recovery: the newest keyframe's landmarks matched by descriptor alone, any camera, no geometry.
+  // The attempt with the most inliers gives the coarse pose.
+  const auto strong = [&](int n) {
+    return n >= options_.min_tracked && n >= options_.strong_tracking_share * last_coarse_inliers_;
+  };
   SE3 coarse = predicted;
+  int best_attempt = -1, last_attempt = -1;
   inliers = 0;
-  for (int attempt = 0; attempt < 2 && inliers < options_.min_tracked; ++attempt) {
+  for (int attempt = 0; attempt < 3 && !strong(inliers); ++attempt) {
     matches_.reset(frame);
-    params.radius_px = options_.track_radius_px * (attempt == 0 ? 1.0 : options_.wide_radius_factor);
-    map_.refreshLiveList();
-    const int32_t* slots = attempt == 0 ? last_tracked_.data() : map_.liveLandmarkSlots();
-    const int n = attempt == 0 ? last_tracked_count_ : map_.liveLandmarkCount();
-    if (search_.search(map_, slots, n, predicted, frame, params, matches_, false) >= options_.min_matches_for_pose) {
-      inliers = poseFromMatches(frame, predicted, true, coarse);
+    last_attempt = attempt;
+    int found = 0;
+    if (attempt < 2) {
+      params.radius_px = options_.track_radius_px * (attempt == 0 ? 1.0 : options_.wide_radius_factor);
+      map_.refreshLiveList();
+      const int32_t* slots = attempt == 0 ? last_tracked_.data() : map_.liveLandmarkSlots();
+      const int n = attempt == 0 ? last_tracked_count_ : map_.liveLandmarkCount();
+      found = search_.search(map_, slots, n, predicted, frame, params, matches_, false);
+    } else {
+      found = searchNewestKeyframeByDescriptor(frame);
     }
-  }
-  // 2. Recovery: match by descriptor alone to the landmarks of the newest keyframe, any camera.
-  if (inliers < options_.min_tracked) {
-    matches_.reset(frame);
-    const int newest = map_.newestKeyframe();
-    int n = 0;
-    if (newest >= 0) {
-      const Keyframe& kf = map_.keyframe(newest);
-      for (int c = 0; c < kf.features.cameras(); ++c) {
-        for (int k = 0; k < kf.features.sets[c].count; ++k) {
-          if (kf.landmark_of[c][k] >= 0) last_tracked_[n++] = kf.landmark_of[c][k];
-        }
-      }
-    }
-    last_tracked_count_ = 0;  // the list now holds keyframe landmarks, possibly repeated: not reusable
-    if (search_.searchByDescriptor(map_, last_tracked_.data(), n, frame, options_.max_hamming, 0.8f, matches_) >=
-        options_.min_matches_for_pose) {
-      inliers = poseFromMatches(frame, predicted, true, coarse);
-      if (inliers >= options_.min_tracked) ++stats_.recoveries;
+    SE3 candidate = predicted;
+    const int n = found >= options_.min_matches_for_pose ? poseFromMatches(frame, predicted, true, candidate) : 0;
+    if (n > inliers) {
+      inliers = n;
+      coarse = candidate;
+      best_attempt = attempt;
     }
   }
   if (inliers < options_.min_tracked) return TrackResult::Failed;
+  if (best_attempt == 2) ++stats_.recoveries;
+  last_coarse_inliers_ = inliers;
+  if (best_attempt != last_attempt) {
+    // A later attempt replaced the best one's matches: find them again around the coarse pose.
+    matches_.reset(frame);
+    map_.refreshLiveList();
+    params.radius_px = options_.track_radius_px;
+    search_.search(map_, map_.liveLandmarkSlots(), map_.liveLandmarkCount(), coarse, frame, params, matches_, false);
+  }
 
   // 3. The local map, projected with the coarse pose into every camera, then the final refinement.
   map_.refreshLiveList();
@@ -284,6 +294,21 @@ Odometry::TrackResult Odometry::track(const FrameFeatures& frame, uint64_t frame
     }
   }
   return TrackResult::Ok;
+}
+
+int Odometry::searchNewestKeyframeByDescriptor(const FrameFeatures& frame) {
+  const int newest = map_.newestKeyframe();
+  int n = 0;
+  if (newest >= 0) {
+    const Keyframe& kf = map_.keyframe(newest);
+    for (int c = 0; c < kf.features.cameras(); ++c) {
+      for (int k = 0; k < kf.features.sets[c].count; ++k) {
+        if (kf.landmark_of[c][k] >= 0) last_tracked_[n++] = kf.landmark_of[c][k];
+      }
+    }
+  }
+  last_tracked_count_ = 0;  // the list now holds keyframe landmarks, possibly repeated: not reusable
+  return search_.searchByDescriptor(map_, last_tracked_.data(), n, frame, options_.max_hamming, 0.8f, matches_);
 }
 
 int Odometry::poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b) {

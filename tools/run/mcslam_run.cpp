@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
   std::string dataset_dir, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
   bool quiet = false, print_config = false;
+  std::size_t max_frames = 0;
   app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
       ->required();
   app.add_option("--config", config_path, "YAML file with a `slam:` section (see config/slam.yaml); defaults otherwise");
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   app.add_option("--keyframes", keyframes_path, "Keyframe poses, TUM format");
   app.add_option("--stats", stats_path, "Timing per stage (mean, p99) and tracking states, JSON");
   app.add_option("--extrinsics", extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
+  app.add_option("--frames", max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", quiet, "No progress bar");
   app.add_flag("--print-config", print_config,
                "Print the effective `slam:` configuration (defaults, --config, this dataset's rig) and exit");
@@ -84,11 +86,12 @@ int main(int argc, char** argv) {
       return 0;
     }
     SlamPipeline pipeline(ds.rig(), config);
+    const std::size_t frames = max_frames > 0 ? std::min(max_frames, ds.size()) : ds.size();
     run::RunReport report;
     const bool show = !quiet && ::isatty(STDERR_FILENO);
     if (!quiet) {
       std::fprintf(stderr, "mcslam-run: %s (%s), %d camera%s, %zu frames\n", dataset_dir.c_str(), ds.format().c_str(),
-                   ds.rig().size(), ds.rig().size() == 1 ? "" : "s", ds.size());
+                   ds.rig().size(), ds.rig().size() == 1 ? "" : "s", frames);
     }
 
     const auto wall_start = std::chrono::steady_clock::now();
@@ -97,9 +100,9 @@ int main(int argc, char** argv) {
     std::unique_ptr<bool[]> present(new bool[ds.rig().size()]);
     bool was_initialized = false;
     double ms_avg = 0;
-    for (std::size_t i = 0; i < ds.size(); ++i) {
+    for (std::size_t i = 0; i < frames; ++i) {
       LoadedFrame frame = next.get();
-      if (i + 1 < ds.size()) next = std::async(std::launch::async, loadFrame, std::cref(ds), i + 1);  // decode ahead
+      if (i + 1 < frames) next = std::async(std::launch::async, loadFrame, std::cref(ds), i + 1);  // decode ahead
       if (!frame.error.empty()) std::fprintf(stderr, "%smcslam-run: frame %zu: %s\n", show ? "\n" : "", i, frame.error.c_str());
       for (int c = 0; c < ds.rig().size(); ++c) {
         present[c] = frame.present[c];
@@ -121,7 +124,7 @@ int main(int argc, char** argv) {
       was_initialized = initialized;
       if (pose.is_keyframe) report.noteKeyframes(pipeline.odometry().map());
       ms_avg = i == 0 ? pipeline.timing().total_ms : 0.95 * ms_avg + 0.05 * pipeline.timing().total_ms;
-      if (show && (i % 5 == 0 || i + 1 == ds.size())) progress(i + 1, ds.size(), ms_avg, pose);
+      if (show && (i % 5 == 0 || i + 1 == frames)) progress(i + 1, frames, ms_avg, pose);
     }
     report.noteKeyframes(pipeline.odometry().map());
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

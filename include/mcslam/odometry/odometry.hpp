@@ -70,6 +70,7 @@ class Odometry {
   int countKeyframeLandmarks(int slot) const;
   void resetMap();
   void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
+  int searchNewestKeyframeByDescriptor(const FrameFeatures& frame);
 
   Rig rig_;
   OdometryOptions options_;
@@ -86,6 +87,7 @@ class Odometry {
   std::vector<KeypointRef> observation_refs_;  // which keypoint each observation is
   std::vector<int32_t> last_tracked_;          // landmark slots tracked in the previous frame
   int last_tracked_count_ = 0;
+  int last_coarse_inliers_ = 0;  // RANSAC inliers of the previous frame's coarse pose
 
   bool initialized_ = false;
   bool have_velocity_ = false;

@@ -23,6 +23,7 @@ struct OdometryOptions {
   double local_map_radius_px = 4.0;  // radius for the local map, once the pose is known
   int min_matches_for_pose = 12;     // RANSAC needs at least this many matches to try
   int min_tracked = 12;              // fewer inliers after refinement: the frame is lost
+  double strong_tracking_share = 0.25;  // a coarse pose is trusted with this share of the previous frame's inliers
 
   // Keyframes.
   double keyframe_tracked_ratio = 0.75;  // new keyframe when tracked landmarks fall below this share of the last keyframe's
