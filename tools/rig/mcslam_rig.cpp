@@ -10,6 +10,7 @@
 #include "mcslam/core/json_writer.hpp"
 #include "mcslam/dataset/dataset.hpp"
 #include "overlap_report.hpp"
+#include "rig_edit.hpp"
 
 using namespace mcslam;
 
@@ -101,10 +102,32 @@ int main(int argc, char** argv) {
   ov->add_option("--min-depth", overlap.min_depth, "Nearest scene depth, metres")->capture_default_str();
   ov->add_option("--max-depth", overlap.max_depth, "Farthest scene depth, metres")->capture_default_str();
   ov->add_option("--cell-size", overlap.cell_size_px, "Grid cell size, pixels")->capture_default_str();
+
+  int camera = 0;
+  double translation = 0.02, rotation_deg = 1.0;
+  uint64_t seed = 1;
+  std::string out_path, other;
+  auto* perturb = app.add_subcommand("perturb", "Move one camera's extrinsic (what-if calibration error); writes Kalibr YAML");
+  perturb->add_option("CALIB", calib, "Calibration (as for info)")->required();
+  perturb->add_option("--camera", camera, "Camera index")->required();
+  perturb->add_option("--translation", translation, "Translation error, metres (random direction)")->capture_default_str();
+  perturb->add_option("--rotation-deg", rotation_deg, "Rotation error, degrees (random axis)")->capture_default_str();
+  perturb->add_option("--seed", seed, "Seed of the direction and axis")->capture_default_str();
+  perturb->add_option("--out", out_path, "Kalibr camchain YAML to write")->required();
+  auto* compare = app.add_subcommand("compare", "Per-camera extrinsic difference between two calibrations of one rig");
+  compare->add_option("CALIB", calib, "First calibration")->required();
+  compare->add_option("OTHER", other, "Second calibration (e.g. mcslam-run --extrinsics output)")->required();
+  compare->add_flag("--json", json, "Print JSON (keys: cameras[index, translation_m, rotation_deg])");
+  std::string subset;
+  compare->add_option("--cameras", subset, "Compare only these cameras of CALIB (e.g. 0,1,2,3,4: OTHER holds that subset)");
   CLI11_PARSE(app, argc, argv);
   try {
     const Rig rig = loadRigFromPath(calib);
-    if (info->parsed()) {
+    if (perturb->parsed()) {
+      writeKalibrRig(rigtool::perturbExtrinsic(rig, camera, translation, rotation_deg, seed), out_path);
+    } else if (compare->parsed()) {
+      rigtool::printComparison(subset.empty() ? rig : rig.subset(parseCameraList(subset)), loadRigFromPath(other), json);
+    } else if (info->parsed()) {
       if (json) printInfoJson(rig);
       else printInfoText(rig, calib);
     } else {

@@ -56,12 +56,14 @@ void progress(std::size_t done, std::size_t total, double ms_per_frame, const Po
 
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
-  std::string dataset_dir, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
+  std::string dataset_dir, calibration_path, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
   bool quiet = false, print_config = false;
   std::size_t max_frames = 0;
   app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
       ->required();
   app.add_option("--config", config_path, "YAML file with a `slam:` section (see config/slam.yaml); defaults otherwise");
+  app.add_option("--calibration", calibration_path,
+                 "Calibration to use instead of the dataset's own (Kalibr YAML, EuRoC sensor.yaml, KITTI calib.txt)");
   app.add_option("--cameras", cameras_text, "Cameras of the rig to use, by calibration index, e.g. 0,1,2 (default: all)");
   app.add_option("--out", out_path, "Trajectory of every frame, TUM format (pose of the body in the world)");
   app.add_option("--keyframes", keyframes_path, "Keyframe poses, TUM format");
@@ -76,6 +78,7 @@ int main(int argc, char** argv) {
   try {
     DatasetOptions dopt;
     if (!cameras_text.empty()) dopt.cameras = parseCameraList(cameras_text);
+    dopt.calibration_override = calibration_path;
     const Dataset ds = Dataset::open(dataset_dir, dopt);
     for (const std::string& w : ds.warnings()) std::fprintf(stderr, "mcslam-run: warning: %s\n", w.c_str());
     if (ds.size() == 0) throw InputError(dataset_dir + ": the dataset has no frames");
