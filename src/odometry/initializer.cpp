@@ -99,7 +99,6 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
     r = estimateGeneralizedRelativePose(rig_, correspondences_, ro);
   }
   last_status_ = r.status;
-  if (std::getenv("MCSLAM_DEBUG_INIT")) std::fprintf(stderr, "init frame %llu ref %llu matches %d status %s inliers %d iters %d scale_sigma %.3f parallax %.4f t %.3f\n", (unsigned long long)frame_index, (unsigned long long)reference_index_, last_matches_, relativePoseStatusName(r.status), r.num_inliers, r.ransac_iterations, r.relative_scale_sigma, r.median_parallax_rad, r.T_1_2.t.norm());
   if (!r.ok()) return TwoFrame::Waiting;
   if (rig_.size() == 1) {
     // The central solver works in camera frames: bring the motion into the body frame.

@@ -304,7 +304,6 @@ int LocalMapper::triangulateWithPrevious(int slot) {
           candidates_[claim].distance = -1;  // beaten
         }
         claim = nc;
-        ++debug_candidates_;
         candidates_[nc++] = Candidate{static_cast<int16_t>(c2), static_cast<int16_t>(best_c1), a, best_b,
                                       static_cast<int16_t>(best)};
       }
@@ -341,7 +340,6 @@ int LocalMapper::triangulateWithPrevious(int slot) {
       addRays(slot, cand.cam_new, cand.kp_new);
       addRays(po, cand.cam_old, cand.kp_old);
       const TriangulationResult tri = triangulate(tri_obs_.data(), n, options_.new_points);
-      if (std::getenv("MCSLAM_DEBUG_MAPPING")) ++debug_status_[static_cast<int>(tri.status)];
       if (!tri.ok()) continue;
       const int lm = map_.createLandmark(tri.point, kn.features.sets[cand.cam_new].descriptors[cand.kp_new], kn.id);
       if (lm < 0) return created;
@@ -351,13 +349,6 @@ int LocalMapper::triangulateWithPrevious(int slot) {
     }
   }
   finishTouched();
-  if (std::getenv("MCSLAM_DEBUG_MAPPING")) {
-    std::fprintf(stderr, "triangulate kf %lld: candidates %d created %d status", (long long)kn.id, debug_candidates_, created);
-    for (int i = 0; i < 7; ++i) std::fprintf(stderr, " %s=%d", triangulationStatusName(static_cast<TriangulationStatus>(i)), debug_status_[i]);
-    std::fprintf(stderr, "\n");
-    for (int& d : debug_status_) d = 0;
-    debug_candidates_ = 0;
-  }
   return created;
 }
 

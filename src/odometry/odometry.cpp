@@ -82,7 +82,6 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
   int inliers = 0;
   const TrackResult result = track(frame, frame_index, T_w_b, inliers);
   if (result == TrackResult::Failed) {
-    if (std::getenv("MCSLAM_DEBUG_ODOMETRY")) std::fprintf(stderr, "frame %llu LOST inliers %d landmarks %d\n", (unsigned long long)frame_index, inliers, map_.liveLandmarks());
     ++stats_.lost;
     ++lost_frames_;
     // Carry on with the motion model so the trajectory stays continuous, and rebuild the map from
@@ -128,11 +127,6 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
     }
   }
   rememberTracked(frame, frame_index);
-  if (std::getenv("MCSLAM_DEBUG_ODOMETRY")) {
-    std::fprintf(stderr, "frame %llu inliers %d kf %d landmarks %d tracked_list %d t %.3f %.3f %.3f\n",
-                 (unsigned long long)frame_index, inliers, out.is_keyframe ? 1 : 0, map_.liveLandmarks(), last_tracked_count_,
-                 T_w_last_.t.x(), T_w_last_.t.y(), T_w_last_.t.z());
-  }
   out.T_w_b = T_w_last_;
   out.state = TrackingState::Tracking;
   out.valid = true;

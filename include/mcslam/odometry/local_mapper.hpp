@@ -72,8 +72,6 @@ class LocalMapper {
   int capacity_;
   bool monocular_ = false;
   double last_backend_ms_ = 0;
-  int debug_status_[8] = {0};
-  int debug_candidates_ = 0;
   uint64_t backend_solves_ = 0;
 };
 
