@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "mcslam/core/error.hpp"
 
@@ -41,29 +42,82 @@ int FrameFeatures::monoCount() const {
 }
 
 namespace {
-constexpr int kMaxOctaves = 32;
+
+// Keypoints of camera j whose bearing is within 30 degrees of the baseline are not sorted by plane angle:
+// near the epipole a pixel-sized gate spans a wide range of plane angles.
+constexpr double kNearEpipoleSine = 0.5;
+
+inline int popcountPortable(uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
 }
+
+void hammingBatchPortable(const Descriptor& a, const Descriptor* set, const int32_t* index, int n, int16_t* out) {
+  for (int k = 0; k < n; ++k) {
+    const Descriptor& b = set[index[k]];
+    out[k] = static_cast<int16_t>(popcountPortable(a[0] ^ b[0]) + popcountPortable(a[1] ^ b[1]) +
+                                  popcountPortable(a[2] ^ b[2]) + popcountPortable(a[3] ^ b[3]));
+  }
+}
+
+// The build targets generic x86-64 (no -march): the POPCNT instruction is used only where the CPU has it.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+__attribute__((target("popcnt"))) void hammingBatchPopcnt(const Descriptor& a, const Descriptor* set,
+                                                          const int32_t* index, int n, int16_t* out) {
+  for (int k = 0; k < n; ++k) {
+    const Descriptor& b = set[index[k]];
+    out[k] = static_cast<int16_t>(__builtin_popcountll(a[0] ^ b[0]) + __builtin_popcountll(a[1] ^ b[1]) +
+                                  __builtin_popcountll(a[2] ^ b[2]) + __builtin_popcountll(a[3] ^ b[3]));
+  }
+}
+bool cpuHasPopcnt() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("popcnt");
+}
+#else
+void hammingBatchPopcnt(const Descriptor& a, const Descriptor* set, const int32_t* index, int n, int16_t* out) {
+  for (int k = 0; k < n; ++k) out[k] = static_cast<int16_t>(hammingDistance(a, set[index[k]]));
+}
+bool cpuHasPopcnt() { return true; }
+#endif
+
+}  // namespace
 
 MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, const MultiViewOptions& options,
                                    int max_features_per_camera)
     : rig_(rig), overlap_(overlap), options_(options), capacity_(max_features_per_camera) {
   const int n = rig.size();
   if (n > 64) throw InputError("multi-view features support at most 64 cameras per rig");
+  hamming_batch_ = cpuHasPopcnt() ? &hammingBatchPopcnt : &hammingBatchPortable;
+  for (int o = 0; o < kMaxOctaves; ++o) {
+    sigma_[o] = std::pow(static_cast<double>(options_.octave_scale), o);
+    same_px2_[o] = (options_.duplicate_px * sigma_[o]) * (options_.duplicate_px * sigma_[o]);
+  }
   cell_start_.resize(n);
   cell_items_.resize(n);
   cell_of_.resize(n);
+  dir_b_.resize(n);
+  int max_cells = 1;
   for (int c = 0; c < n; ++c) {
     cell_start_[c].resize(overlap.grid(c).cells() + 1);
     cell_items_[c].resize(capacity_);
     cell_of_[c].resize(capacity_);
+    dir_b_[c].resize(capacity_);
+    max_cells = std::max(max_cells, overlap.grid(c).cells());
   }
+  cell_stamp_.assign(max_cells, 0);
+  plane_angle_.resize(capacity_);
+  sorted_b_.resize(capacity_);
+  sorted_angle_.resize(capacity_);
+  near_epipole_b_.resize(capacity_);
   const std::size_t pairs = overlap.overlappingPairs().size();
   matches_.resize(std::max<std::size_t>(1, pairs * capacity_));
   order_.resize(matches_.size());
   best_for_b_.resize(capacity_);
   best_dist_for_b_.resize(capacity_);
   second_dist_for_b_.resize(capacity_);
-  epipolar_normals_.resize(capacity_);
   candidate_b_.resize(capacity_);
   candidate_dist_.resize(capacity_);
   parent_.resize(static_cast<std::size_t>(n) * capacity_);
@@ -92,10 +146,12 @@ void MultiViewMatcher::compute(FrameFeatures& f) {
 void MultiViewMatcher::computeBearings(FrameFeatures& f) {
   for (int c = 0; c < f.cameras(); ++c) {
     const CameraModel& model = rig_.model(c);
+    const Mat3 R_b_c = rig_.T_b_c(c).R;
     const FeatureSet& s = f.sets[c];
     for (int k = 0; k < s.count; ++k) {
       f.valid[c][k] = model.unproject(Vec2(s.keypoints[k].x, s.keypoints[k].y), f.bearings[c][k]) ? 1 : 0;
       f.mv_of[c][k] = -1;
+      dir_b_[c][k] = R_b_c * f.bearings[c][k];
     }
   }
 }
@@ -121,60 +177,141 @@ void MultiViewMatcher::bucketKeypoints(const FrameFeatures& f) {
   }
 }
 
+// Epipolar geometry about the baseline: every epipolar plane of the pair contains the baseline, so it is
+// one half-plane of a pencil, identified by its angle about the baseline axis. A scene point lies on the
+// same half-plane seen from either camera (the two rays differ by a multiple of the baseline). Camera j's
+// keypoints are sorted by that angle once per pair; each keypoint of camera i then visits only those of its
+// angle window (the band around its epipolar curve), and only in the overlap map's candidate cells.
 void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
-  const SE3 T_j_i = rig_.T_b_c(j).inverse() * rig_.T_b_c(i);
   const FeatureSet& si = f.sets[i];
   const FeatureSet& sj = f.sets[j];
+  const Vec3 baseline = rig_.T_b_c(j).t - rig_.T_b_c(i).t;  // body frame
+  const double baseline_norm = baseline.norm();
+  if (!(baseline_norm > 1e-9)) return;  // common centre: no epipolar geometry
+  const Vec3 e = baseline / baseline_norm;
+  const Vec3 u = e.unitOrthogonal();
+  const Vec3 v = e.cross(u);
   const double fj = 0.5 * (rig_.model(j).fx() + rig_.model(j).fy());
   double gate[kMaxOctaves];  // sine of the largest angle to the epipolar plane, per octave of the keypoint in j
-  for (int o = 0; o < kMaxOctaves; ++o) gate[o] = options_.epipolar_px * std::pow(options_.octave_scale, o) / fj;
+  for (int o = 0; o < kMaxOctaves; ++o) gate[o] = options_.epipolar_px * sigma_[o] / fj;
+
+  // Camera j's keypoints by plane angle; those near the epipole apart.
+  int sorted = 0, near = 0;
+  double min_sine = 1.0;
+  for (int b = 0; b < sj.count; ++b) {
+    if (!f.valid[j][b] || cell_of_[j][b] < 0) continue;
+    const Vec3& d = dir_b_[j][b];
+    const double x = u.dot(d), y = v.dot(d);
+    const double sine = std::sqrt(x * x + y * y);  // of the angle between the bearing and the baseline
+    if (sine < kNearEpipoleSine) {
+      near_epipole_b_[near++] = b;
+      continue;
+    }
+    plane_angle_[b] = static_cast<float>(std::atan2(y, x));
+    min_sine = std::min(min_sine, sine);
+    sorted_b_[sorted++] = b;
+  }
+  std::sort(sorted_b_.begin(), sorted_b_.begin() + sorted,
+            [&](int32_t p, int32_t q) { return plane_angle_[p] < plane_angle_[q]; });
+  for (int k = 0; k < sorted; ++k) sorted_angle_[k] = plane_angle_[sorted_b_[k]];
+  // Half-width of the angle window per octave of the keypoint in j: |n . d| = sine * |sin(angle difference)|.
+  double window[kMaxOctaves];
+  for (int o = 0; o < kMaxOctaves; ++o) {
+    const double s = gate[o] / min_sine;
+    window[o] = s >= 1.0 ? M_PI : std::asin(s) + 1e-5;  // margin for the float angles
+  }
 
   std::fill(best_for_b_.begin(), best_for_b_.begin() + sj.count, -1);
   std::fill(best_dist_for_b_.begin(), best_dist_for_b_.begin() + sj.count, int16_t{257});
   std::fill(second_dist_for_b_.begin(), second_dist_for_b_.begin() + sj.count, int16_t{257});
   const int first_match = match_count_;
+  const CellGrid& gi = overlap_.grid(i);
+  const float* angles = sorted_angle_.data();
 
-  for (int a = 0; a < si.count; ++a) {
-    if (!f.valid[i][a] || cell_of_[i][a] < 0) continue;
-    // Normal of the epipolar plane of keypoint a, in camera j: the baseline crossed with its ray.
-    Vec3 n = T_j_i.t.cross(T_j_i.R * f.bearings[i][a]);
-    const double nn = n.norm();
-    if (nn < 1e-12) continue;  // the ray passes through camera j's centre
-    n /= nn;
-    const Descriptor& da = si.descriptors[a];
-    const int oa = si.keypoints[a].octave;
-    int best = 257, best_b = -1, candidates = 0;
-    for (const int32_t cell : overlap_.candidates(i, j, cell_of_[i][a])) {
-      for (int32_t idx = cell_start_[j][cell]; idx < cell_start_[j][cell + 1]; ++idx) {
-        const int b = cell_items_[j][idx];
-        if (!f.valid[j][b]) continue;
+  for (int cell_i = 0; cell_i < gi.cells(); ++cell_i) {
+    const int32_t begin = cell_start_[i][cell_i], end = cell_start_[i][cell_i + 1];
+    if (begin == end) continue;
+    const std::span<const int32_t> cells_j = overlap_.candidates(i, j, cell_i);
+    if (cells_j.empty()) continue;
+    if (++stamp_ == 0) {  // wrapped: clear the old stamps
+      std::fill(cell_stamp_.begin(), cell_stamp_.end(), 0u);
+      stamp_ = 1;
+    }
+    for (const int32_t c : cells_j) cell_stamp_[c] = stamp_;
+
+    for (int32_t item = begin; item < end; ++item) {
+      const int a = cell_items_[i][item];
+      if (!f.valid[i][a]) continue;
+      const Vec3& da = dir_b_[i][a];
+      // Normal of the epipolar plane of keypoint a: the baseline crossed with its ray.
+      Vec3 n = e.cross(da);
+      const double nn = n.norm();
+      if (nn < 1e-12) continue;  // the ray runs along the baseline
+      n /= nn;
+      const Vec3 perp = da - e * e.dot(da);  // its half-plane
+      const int oa = si.keypoints[a].octave;
+      int candidates = 0;
+      auto consider = [&](int b) {
+        if (cell_stamp_[cell_of_[j][b]] != stamp_) return;
         const int ob = sj.keypoints[b].octave;
-        if (std::abs(oa - ob) > options_.max_octave_difference) continue;
-        if (std::abs(n.dot(f.bearings[j][b])) > gate[std::min(ob, kMaxOctaves - 1)]) continue;
-        const int d = hammingDistance(da, sj.descriptors[b]);
-        candidate_b_[candidates] = b;
-        candidate_dist_[candidates++] = static_cast<int16_t>(d);
+        if (std::abs(oa - ob) > options_.max_octave_difference) return;
+        const Vec3& db = dir_b_[j][b];
+        if (std::abs(n.dot(db)) > gate[std::min(ob, kMaxOctaves - 1)]) return;
+        candidate_b_[candidates++] = b;
+      };
+      const double w = window[std::clamp(oa + options_.max_octave_difference, 0, kMaxOctaves - 1)];
+      if (w >= M_PI) {
+        for (int k = 0; k < sorted; ++k) consider(sorted_b_[k]);
+      } else {
+        const double angle = std::atan2(v.dot(da), u.dot(da));
+        // Scans sorted positions with angle in [lo, hi] (lo, hi within [-pi, pi] after wrapping).
+        auto scan = [&](double lo, double hi) {
+          int k = static_cast<int>(std::lower_bound(angles, angles + sorted, static_cast<float>(lo)) - angles);
+          for (; k < sorted && angles[k] <= hi; ++k) consider(sorted_b_[k]);
+        };
+        const double lo = angle - w, hi = angle + w;
+        if (lo < -M_PI) {
+          scan(-M_PI, hi);
+          scan(lo + 2 * M_PI, M_PI);
+        } else if (hi > M_PI) {
+          scan(lo, M_PI);
+          scan(-M_PI, hi - 2 * M_PI);
+        } else {
+          scan(lo, hi);
+        }
+      }
+      for (int k = 0; k < near; ++k) {
+        const int b = near_epipole_b_[k];
+        if (perp.dot(dir_b_[j][b]) > 0) consider(b);
+      }
+      if (candidates == 0) continue;
+      hamming_batch_(si.descriptors[a], sj.descriptors.data(), candidate_b_.data(), candidates,
+                     candidate_dist_.data());
+      int best = 257, best_b = -1;
+      for (int c = 0; c < candidates; ++c) {
+        const int d = candidate_dist_[c];
+        const int b = candidate_b_[c];
         if (d < best) {
           best = d;
           best_b = b;
         }
         noteForB(si, b, a, d);
       }
+      if (best_b < 0 || best > options_.max_hamming) continue;
+      // Ratio test against the best candidate elsewhere on the epipolar curve. The pyramid detects one corner
+      // at several octaves with near-identical descriptors; such a copy of the best is no rival.
+      const Keypoint& kb = sj.keypoints[best_b];
+      const double same2 = same_px2_[std::clamp<int>(kb.octave, 0, kMaxOctaves - 1)];
+      int second = 257;
+      for (int c = 0; c < candidates; ++c) {
+        const Keypoint& kc = sj.keypoints[candidate_b_[c]];
+        const double dx = kc.x - kb.x, dy = kc.y - kb.y;
+        if (candidate_dist_[c] < second && dx * dx + dy * dy > same2) second = candidate_dist_[c];
+      }
+      if (!(best < options_.ratio * second)) continue;
+      matches_[match_count_++] = Match{static_cast<int16_t>(i), static_cast<int16_t>(j), a, best_b,
+                                       static_cast<int16_t>(best)};
     }
-    if (best_b < 0 || best > options_.max_hamming) continue;
-    // Ratio test against the best candidate elsewhere on the epipolar curve. The pyramid detects one corner
-    // at several octaves with near-identical descriptors; such a copy of the best is no rival.
-    const Keypoint& kb = sj.keypoints[best_b];
-    const double same_px = options_.duplicate_px * std::pow(options_.octave_scale, kb.octave);
-    int second = 257;
-    for (int c = 0; c < candidates; ++c) {
-      const Keypoint& kc = sj.keypoints[candidate_b_[c]];
-      const double dx = kc.x - kb.x, dy = kc.y - kb.y;
-      if (candidate_dist_[c] < second && dx * dx + dy * dy > same_px * same_px) second = candidate_dist_[c];
-    }
-    if (!(best < options_.ratio * second)) continue;
-    matches_[match_count_++] = Match{static_cast<int16_t>(i), static_cast<int16_t>(j), a, best_b,
-                                     static_cast<int16_t>(best)};
   }
   // Keep only mutual best matches that pass the ratio test both ways: b's best keypoint of camera i must be a,
   // and clearly better than any other corner of camera i on the same epipolar curve. One way is not enough:
@@ -198,9 +335,8 @@ void MultiViewMatcher::noteForB(const FeatureSet& si, int b, int a, int d) {
   if (best_a >= 0) {
     const Keypoint& ka = si.keypoints[a];
     const Keypoint& kb = si.keypoints[best_a];
-    const double same_px = options_.duplicate_px * std::pow(options_.octave_scale, std::max(ka.octave, kb.octave));
     const double dx = ka.x - kb.x, dy = ka.y - kb.y;
-    copy_of_best = dx * dx + dy * dy <= same_px * same_px;
+    copy_of_best = dx * dx + dy * dy <= same_px2_[std::clamp<int>(std::max(ka.octave, kb.octave), 0, kMaxOctaves - 1)];
   }
   if (d < best_dist_for_b_[b]) {
     if (!copy_of_best) second_dist_for_b_[b] = best_dist_for_b_[b];
@@ -291,7 +427,7 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
       o.T_f_c = rig_.T_b_c(r.cam);
       o.uv = Vec2(kp.x, kp.y);
       o.bearing = f.bearings[r.cam][r.index];
-      o.sigma_px = std::pow(options_.octave_scale, kp.octave);
+      o.sigma_px = sigma_[std::clamp<int>(kp.octave, 0, kMaxOctaves - 1)];
     }
   };
   TriangulationResult tri;

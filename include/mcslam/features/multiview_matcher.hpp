@@ -57,16 +57,34 @@ class MultiViewMatcher {
   void finishTrack(FrameFeatures& f, int first, int size);
   int find(int node);
 
+  // Descriptor distances of one keypoint against a list of keypoints (popcnt or portable, chosen at start).
+  using HammingBatch = void (*)(const Descriptor& a, const Descriptor* set, const int32_t* index, int n,
+                                int16_t* out);
+
   const Rig& rig_;
   const OverlapMap& overlap_;
   MultiViewOptions options_;
   int capacity_;
   MultiViewStats stats_;
+  HammingBatch hamming_batch_ = nullptr;
+  static constexpr int kMaxOctaves = 32;
+  double same_px2_[kMaxOctaves] = {};  // (duplicate_px * sigma(octave))^2
+  double sigma_[kMaxOctaves] = {};     // octave_scale^octave
 
   // Keypoints bucketed by cell, per camera (counting sort).
   std::vector<std::vector<int32_t>> cell_start_;  // cells + 1
   std::vector<std::vector<int32_t>> cell_items_;
   std::vector<std::vector<int32_t>> cell_of_;     // per keypoint
+  std::vector<std::vector<Vec3>> dir_b_;          // per keypoint: bearing rotated into the body frame
+
+  // Per pair: camera j's keypoints sorted by the angle of their epipolar plane about the baseline, and
+  // the candidate cells of the current cell of camera i marked with a stamp.
+  std::vector<float> plane_angle_;       // per keypoint of camera j
+  std::vector<int32_t> sorted_b_;        // keypoints of j away from the epipole, by plane angle
+  std::vector<float> sorted_angle_;
+  std::vector<int32_t> near_epipole_b_;  // keypoints of j close to the baseline direction: checked one by one
+  std::vector<uint32_t> cell_stamp_;     // per cell of camera j
+  uint32_t stamp_ = 0;
 
   // Pairwise matches and their merge.
   std::vector<Match> matches_;
@@ -82,7 +100,6 @@ class MultiViewMatcher {
   std::vector<int32_t> component_size_;
   std::vector<int32_t> members_;         // nodes grouped by component
   std::vector<TriangulationObservation> scratch_obs_;
-  std::vector<Vec3> epipolar_normals_;   // per keypoint of camera i, in camera j's frame
   std::vector<int32_t> candidate_b_;     // epipolar-consistent candidates of the current keypoint
   std::vector<int16_t> candidate_dist_;
 };
