@@ -95,6 +95,15 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
     sigma_[o] = std::pow(static_cast<double>(options_.octave_scale), o);
     same_px2_[o] = (options_.duplicate_px * sigma_[o]) * (options_.duplicate_px * sigma_[o]);
   }
+  min_metric_views_ = options_.min_metric_views;
+  if (min_metric_views_ <= 0) {
+    min_metric_views_ = 2;
+    for (int c = 0; c < n; ++c) {
+      int partners = 0;
+      for (int d = 0; d < n; ++d) partners += overlap.overlaps(c, d) || overlap.overlaps(d, c) ? 1 : 0;
+      if (partners >= 2) min_metric_views_ = 3;
+    }
+  }
   cell_start_.resize(n);
   cell_items_.resize(n);
   cell_of_.resize(n);
@@ -450,8 +459,28 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
     std::swap(f.mv_refs[first + worst], f.mv_refs[first + size - 1]);
     --size;
   }
-  const bool keep = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain ||
+  bool keep = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain ||
                     tri.status == TriangulationStatus::LowParallax;
+  bool has_point = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain;
+  if (keep && has_point && size == 2 && options_.two_view_visibility_check) {
+    const int c0 = f.mv_refs[first].cam, c1 = f.mv_refs[first + 1].cam;
+    for (int c = 0; c < f.cameras() && keep; ++c) {
+      if (c == c0 || c == c1 || !f.present[c]) continue;
+      if (!(overlap_.overlaps(c, c0) || overlap_.overlaps(c0, c) || overlap_.overlaps(c, c1) || overlap_.overlaps(c1, c))) {
+        continue;
+      }
+      const CameraModel& model = rig_.model(c);
+      const Vec3 p_c = rig_.T_b_c(c).inverse() * tri.point;
+      if (!(p_c.norm() > options_.triangulation.min_depth)) continue;
+      if (model.distortion() != Distortion::Equidistant && !(p_c.z() > options_.triangulation.min_depth)) continue;
+      Vec2 uv;
+      if (!model.project(p_c, uv)) continue;
+      const double m = options_.visibility_margin_px;
+      if (uv.x() >= m && uv.y() >= m && uv.x() <= model.width() - 1 - m && uv.y() <= model.height() - 1 - m) {
+        keep = false;  // a camera that should see the point has no keypoint in the track
+      }
+    }
+  }
   if (!keep) {
     ++stats_.dropped;
     return;  // its keypoints stay mono features
@@ -459,8 +488,8 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
   MultiViewFeature& mv = f.mv[f.mv_count];
   mv.first = first;
   mv.size = static_cast<int16_t>(size);
-  mv.has_point = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain;
-  mv.metric = tri.status == TriangulationStatus::Ok;
+  mv.has_point = has_point;
+  mv.metric = tri.status == TriangulationStatus::Ok && size >= min_metric_views_;
   mv.p_b = tri.point;
   mv.relative_depth_sigma = static_cast<float>(tri.relative_depth_sigma);
   // Representative descriptor: the medoid (least total Hamming distance to the others).

@@ -21,6 +21,14 @@ struct MultiViewOptions {
   int max_octave_difference = 2;    // scale consistency between the two keypoints
   double duplicate_px = 3.0;        // candidates this close to the best (x octave sigma) are the same corner
   TriangulationOptions triangulation;  // max_relative_depth_sigma decides which points are metric
+  // A two-view match has no geometric check of its depth (a wrong partner along the epipolar curve is just
+  // another depth). Its point is kept only if no other present camera should see it: projecting inside
+  // that camera's image, more than this margin from the border, without a keypoint in the track.
+  bool two_view_visibility_check = true;
+  double visibility_margin_px = 24.0;
+  // Rays a metric point needs (a third ray verifies the depth); 0: 3 when some camera overlaps two others,
+  // else 2 (stereo pairs, rings of pairwise overlaps).
+  int min_metric_views = 0;
 
   MultiViewOptions() { triangulation.max_relative_depth_sigma = 0.01; }
 };
@@ -70,6 +78,7 @@ class MultiViewMatcher {
   static constexpr int kMaxOctaves = 32;
   double same_px2_[kMaxOctaves] = {};  // (duplicate_px * sigma(octave))^2
   double sigma_[kMaxOctaves] = {};     // octave_scale^octave
+  int min_metric_views_ = 2;
 
   // Keypoints bucketed by cell, per camera (counting sort).
   std::vector<std::vector<int32_t>> cell_start_;  // cells + 1
