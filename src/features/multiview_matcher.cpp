@@ -120,6 +120,7 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
   plane_angle_.resize(capacity_);
   sorted_b_.resize(capacity_);
   sorted_angle_.resize(capacity_);
+  sorted_candidates_.resize(capacity_);
   near_epipole_b_.resize(capacity_);
   const std::size_t pairs = overlap.overlappingPairs().size();
   matches_.resize(std::max<std::size_t>(1, pairs * capacity_));
@@ -202,7 +203,11 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
   const Vec3 v = e.cross(u);
   const double fj = 0.5 * (rig_.model(j).fx() + rig_.model(j).fy());
   double gate[kMaxOctaves];  // sine of the largest angle to the epipolar plane, per octave of the keypoint in j
-  for (int o = 0; o < kMaxOctaves; ++o) gate[o] = options_.epipolar_px * sigma_[o] / fj;
+  float gate_f[kMaxOctaves];
+  for (int o = 0; o < kMaxOctaves; ++o) {
+    gate[o] = options_.epipolar_px * sigma_[o] / fj;
+    gate_f[o] = static_cast<float>(gate[o]);
+  }
 
   // Camera j's keypoints by plane angle; those near the epipole apart.
   int sorted = 0, near = 0;
@@ -222,7 +227,13 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
   }
   std::sort(sorted_b_.begin(), sorted_b_.begin() + sorted,
             [&](int32_t p, int32_t q) { return plane_angle_[p] < plane_angle_[q]; });
-  for (int k = 0; k < sorted; ++k) sorted_angle_[k] = plane_angle_[sorted_b_[k]];
+  for (int k = 0; k < sorted; ++k) {
+    const int b = sorted_b_[k];
+    const Vec3& d = dir_b_[j][b];
+    sorted_angle_[k] = plane_angle_[b];
+    sorted_candidates_[k] = Candidate{plane_angle_[b], b, cell_of_[j][b], sj.keypoints[b].octave,
+                                      {static_cast<float>(d.x()), static_cast<float>(d.y()), static_cast<float>(d.z())}};
+  }
   // Half-width of the angle window per octave of the keypoint in j: |n . d| = sine * |sin(angle difference)|.
   double window[kMaxOctaves];
   for (int o = 0; o < kMaxOctaves; ++o) {
@@ -269,14 +280,26 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
         candidate_b_[candidates++] = b;
       };
       const double w = window[std::clamp(oa + options_.max_octave_difference, 0, kMaxOctaves - 1)];
+      // The same tests on the packed copy (float bearing: its rounding is far below any gate).
+      const float nf[3] = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
+      const int max_diff = options_.max_octave_difference;
+      auto considerPacked = [&](const Candidate& cand) {
+        if (cell_stamp_[cand.cell] != stamp_) return;
+        if (std::abs(oa - cand.octave) > max_diff) return;
+        const float dot = nf[0] * cand.d[0] + nf[1] * cand.d[1] + nf[2] * cand.d[2];
+        if (std::abs(dot) > gate_f[std::min(cand.octave, kMaxOctaves - 1)]) return;
+        candidate_b_[candidates++] = cand.b;
+      };
+      const Candidate* packed = sorted_candidates_.data();
       if (w >= M_PI) {
-        for (int k = 0; k < sorted; ++k) consider(sorted_b_[k]);
+        for (int k = 0; k < sorted; ++k) considerPacked(packed[k]);
       } else {
         const double angle = std::atan2(v.dot(da), u.dot(da));
         // Scans sorted positions with angle in [lo, hi] (lo, hi within [-pi, pi] after wrapping).
         auto scan = [&](double lo, double hi) {
           int k = static_cast<int>(std::lower_bound(angles, angles + sorted, static_cast<float>(lo)) - angles);
-          for (; k < sorted && angles[k] <= hi; ++k) consider(sorted_b_[k]);
+          const float hif = static_cast<float>(hi);
+          for (; k < sorted && packed[k].angle <= hif; ++k) considerPacked(packed[k]);
         };
         const double lo = angle - w, hi = angle + w;
         if (lo < -M_PI) {
@@ -464,8 +487,13 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
   bool has_point = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain;
   if (keep && has_point && size == 2 && options_.two_view_visibility_check) {
     const int c0 = f.mv_refs[first].cam, c1 = f.mv_refs[first + 1].cam;
+    const double baseline = (rig_.T_b_c(c0).t - rig_.T_b_c(c1).t).norm();
     for (int c = 0; c < f.cameras() && keep; ++c) {
       if (c == c0 || c == c1 || !f.present[c]) continue;
+      // Only a camera nearer to one of the two than they are to each other: its view differs less from
+      // theirs than they differ from each other, so it would have matched a true corner more easily.
+      const double nearer = std::min((rig_.T_b_c(c).t - rig_.T_b_c(c0).t).norm(), (rig_.T_b_c(c).t - rig_.T_b_c(c1).t).norm());
+      if (!(nearer < 0.9 * baseline)) continue;
       if (!(overlap_.overlaps(c, c0) || overlap_.overlaps(c0, c) || overlap_.overlaps(c, c1) || overlap_.overlaps(c1, c))) {
         continue;
       }

@@ -22,8 +22,9 @@ struct MultiViewOptions {
   double duplicate_px = 3.0;        // candidates this close to the best (x octave sigma) are the same corner
   TriangulationOptions triangulation;  // max_relative_depth_sigma decides which points are metric
   // A two-view match has no geometric check of its depth (a wrong partner along the epipolar curve is just
-  // another depth). Its point is kept only if no other present camera should see it: projecting inside
-  // that camera's image, more than this margin from the border, without a keypoint in the track.
+  // another depth). It is dropped when a present camera nearer to one of its two cameras than they are to
+  // each other (a smaller change of view) should see its point, more than this margin inside the image,
+  // and contributed no keypoint: a match found across the wider baseline but not the narrower one.
   bool two_view_visibility_check = true;
   double visibility_margin_px = 24.0;
   // Rays a metric point needs (a third ray verifies the depth); 0: 3 when some camera overlaps two others,
@@ -88,9 +89,17 @@ class MultiViewMatcher {
 
   // Per pair: camera j's keypoints sorted by the angle of their epipolar plane about the baseline, and
   // the candidate cells of the current cell of camera i marked with a stamp.
+  struct Candidate {                     // what the band scan reads, contiguous in plane-angle order
+    float angle;
+    int32_t b;
+    int32_t cell;
+    int32_t octave;
+    float d[3];                          // body-frame bearing
+  };
   std::vector<float> plane_angle_;       // per keypoint of camera j
   std::vector<int32_t> sorted_b_;        // keypoints of j away from the epipole, by plane angle
   std::vector<float> sorted_angle_;
+  std::vector<Candidate> sorted_candidates_;
   std::vector<int32_t> near_epipole_b_;  // keypoints of j close to the baseline direction: checked one by one
   std::vector<uint32_t> cell_stamp_;     // per cell of camera j
   uint32_t stamp_ = 0;
