@@ -225,8 +225,16 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
     min_sine = std::min(min_sine, sine);
     sorted_b_[sorted++] = b;
   }
-  std::sort(sorted_b_.begin(), sorted_b_.begin() + sorted,
-            [&](int32_t p, int32_t q) { return plane_angle_[p] < plane_angle_[q]; });
+  // By octave, then plane angle: a keypoint of camera i scans only the octaves it may match, each with the
+  // window of its own gate.
+  auto octaveOf = [&](int b) { return std::clamp<int>(sj.keypoints[b].octave, 0, kMaxOctaves - 1); };
+  std::sort(sorted_b_.begin(), sorted_b_.begin() + sorted, [&](int32_t p, int32_t q) {
+    const int op = octaveOf(p), oq = octaveOf(q);
+    return op != oq ? op < oq : plane_angle_[p] < plane_angle_[q];
+  });
+  int octave_start[kMaxOctaves + 1] = {};
+  for (int k = 0; k < sorted; ++k) ++octave_start[octaveOf(sorted_b_[k]) + 1];
+  for (int o = 0; o < kMaxOctaves; ++o) octave_start[o + 1] += octave_start[o];
   for (int k = 0; k < sorted; ++k) {
     const int b = sorted_b_[k];
     const Vec3& d = dir_b_[j][b];
@@ -279,27 +287,32 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
         if (std::abs(n.dot(db)) > gate[std::min(ob, kMaxOctaves - 1)]) return;
         candidate_b_[candidates++] = b;
       };
-      const double w = window[std::clamp(oa + options_.max_octave_difference, 0, kMaxOctaves - 1)];
       // The same tests on the packed copy (float bearing: its rounding is far below any gate).
       const float nf[3] = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
-      const int max_diff = options_.max_octave_difference;
-      auto considerPacked = [&](const Candidate& cand) {
-        if (cell_stamp_[cand.cell] != stamp_) return;
-        if (std::abs(oa - cand.octave) > max_diff) return;
-        const float dot = nf[0] * cand.d[0] + nf[1] * cand.d[1] + nf[2] * cand.d[2];
-        if (std::abs(dot) > gate_f[std::min(cand.octave, kMaxOctaves - 1)]) return;
-        candidate_b_[candidates++] = cand.b;
-      };
       const Candidate* packed = sorted_candidates_.data();
-      if (w >= M_PI) {
-        for (int k = 0; k < sorted; ++k) considerPacked(packed[k]);
-      } else {
-        const double angle = std::atan2(v.dot(da), u.dot(da));
-        // Scans sorted positions with angle in [lo, hi] (lo, hi within [-pi, pi] after wrapping).
+      const double angle = std::atan2(v.dot(da), u.dot(da));
+      const int o_lo = std::max(0, oa - options_.max_octave_difference);
+      const int o_hi = std::min(kMaxOctaves - 1, oa + options_.max_octave_difference);
+      for (int ob = o_lo; ob <= o_hi; ++ob) {
+        const int first_k = octave_start[ob], last_k = octave_start[ob + 1];
+        if (first_k == last_k) continue;
+        const float g = gate_f[ob];
+        auto considerPacked = [&](const Candidate& cand) {
+          if (cell_stamp_[cand.cell] != stamp_) return;
+          const float dot = nf[0] * cand.d[0] + nf[1] * cand.d[1] + nf[2] * cand.d[2];
+          if (std::abs(dot) > g) return;
+          candidate_b_[candidates++] = cand.b;
+        };
+        const double w = window[ob];
+        if (w >= M_PI) {
+          for (int k = first_k; k < last_k; ++k) considerPacked(packed[k]);
+          continue;
+        }
+        // Scans this octave's positions with angle in [lo, hi] (within [-pi, pi] after wrapping).
         auto scan = [&](double lo, double hi) {
-          int k = static_cast<int>(std::lower_bound(angles, angles + sorted, static_cast<float>(lo)) - angles);
+          int k = static_cast<int>(std::lower_bound(angles + first_k, angles + last_k, static_cast<float>(lo)) - angles);
           const float hif = static_cast<float>(hi);
-          for (; k < sorted && packed[k].angle <= hif; ++k) considerPacked(packed[k]);
+          for (; k < last_k && packed[k].angle <= hif; ++k) considerPacked(packed[k]);
         };
         const double lo = angle - w, hi = angle + w;
         if (lo < -M_PI) {
