@@ -21,6 +21,8 @@ struct DepthStats {
   int within = 0;       // within 2% of it
   int gross = 0;        // more than 10% off: a wrong match
   int honest = 0;       // within 3 of their own reported sigmas
+  int metric = 0;       // of them reported metric by the front-end (depth sigma <= 1%, verified by a third ray)
+  int metric_within = 0;
 };
 
 // Truth at a keypoint: the depth at its pixel, or at a depth edge (the 5x5 window spans more than 5%) the
@@ -64,6 +66,8 @@ DepthStats checkFrame(sim::Simulation& sim, int frame) {
     s.within += error < 0.02 ? 1 : 0;
     s.gross += error > 0.10 ? 1 : 0;
     s.honest += error < 3.0 * mv.relative_depth_sigma ? 1 : 0;
+    s.metric += mv.metric ? 1 : 0;
+    s.metric_within += mv.metric && error < 0.02 ? 1 : 0;
   }
   return s;
 }
@@ -79,10 +83,12 @@ DepthStats indoorStats() {
       sum.within += s.within;
       sum.gross += s.gross;
       sum.honest += s.honest;
+      sum.metric += s.metric;
+      sum.metric_within += s.metric_within;
     }
-    std::printf("map points %d: within 2%% %.3f, gross %.3f, within 3 sigma %.3f\n", sum.points,
-                static_cast<double>(sum.within) / sum.points, static_cast<double>(sum.gross) / sum.points,
-                static_cast<double>(sum.honest) / sum.points);
+    std::printf("map points %d: within 2%% %.3f, gross %.3f, within 3 sigma %.3f; metric %d, within 2%% %d\n",
+                sum.points, static_cast<double>(sum.within) / sum.points, static_cast<double>(sum.gross) / sum.points,
+                static_cast<double>(sum.honest) / sum.points, sum.metric, sum.metric_within);
     return sum;
   }();
   return total;
@@ -90,18 +96,25 @@ DepthStats indoorStats() {
 
 }  // namespace
 
-// What the front-end achieves today (regression guard): measured 0.73 within 2%, 0.09 gross, 0.91 within 3
-// sigmas on these frames. Wrong matches on periodic texture (book spines, bricks), which a linear array of
-// equally spaced cameras cannot tell from the truth geometrically, and silhouettes make the gross share.
+// What the front-end achieves today (regression guard): measured 2134 points, 0.764 within 2%, 0.056 gross, 0.945
+// within 3 sigmas on these frames (before the two-view visibility check: 2490, 0.734, 0.090, 0.911). Most of the
+// within-2% shortfall is noise, not wrong matches: these frames' points lie mostly 10-30 m away, where the rig's
+// 0.66 m span gives a reported depth sigma of 2-6%. The gross share is mostly keypoints of octaves 4-7 and
+// silhouettes.
 TEST(SimMultiViewDepth, MapPointsOfTheFrontCamerasMostlyHaveTheRenderedDepth) {
   const DepthStats s = indoorStats();
-  ASSERT_GT(s.points, 1500);
-  EXPECT_GE(s.within, 0.68 * s.points);
-  EXPECT_LE(s.gross, 0.12 * s.points);
-  EXPECT_GE(s.honest, 0.87 * s.points);
+  ASSERT_GT(s.points, 1900);
+  EXPECT_GE(s.within, 0.74 * s.points);
+  EXPECT_LE(s.gross, 0.07 * s.points);
+  EXPECT_GE(s.honest, 0.92 * s.points);
+  // Points the front-end calls metric: few here (far scenes), mostly right.
+  EXPECT_GE(s.metric_within, 0.8 * s.metric);
 }
 
-// The front-end issue's target, not met yet (see docs/benchmarks/frontend.md): 98% of map points within 2%.
+// The front-end issue's target, not met (see docs/benchmarks/frontend.md): 98% of map points within 2%. Not
+// reachable for points whose own depth sigma is 2-6%; the population it fits, the metric points (sigma <= 1%),
+// is 12 points on these frames, 10 of them within 2% (before the third-ray requirement: 56 points, 10 within 2%,
+// 44 wrong two-view matches across wide baselines).
 // Run with --gtest_also_run_disabled_tests.
 TEST(SimMultiViewDepth, DISABLED_MapPointsWithinTwoPercentOfTheRenderedDepth) {
   const DepthStats s = indoorStats();
