@@ -114,6 +114,16 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
     cell_items_[c].resize(capacity_);
     cell_of_[c].resize(capacity_);
     dir_b_[c].resize(capacity_);
+    const CameraModel& model = rig.model(c);
+    const int cols = model.width() / kBearingGridStep + 2, rows = model.height() / kBearingGridStep + 2;
+    bearing_grid_cols_.push_back(cols);
+    bearing_grid_.emplace_back(static_cast<std::size_t>(cols) * rows, Vec3::Zero());
+    for (int gy = 0; gy < rows; ++gy) {
+      for (int gx = 0; gx < cols; ++gx) {
+        Vec3 b;
+        if (model.unproject(Vec2(gx * kBearingGridStep, gy * kBearingGridStep), b)) bearing_grid_[c][gy * cols + gx] = b;
+      }
+    }
     max_cells = std::max(max_cells, overlap.grid(c).cells());
   }
   cell_stamp_.assign(max_cells, 0);
@@ -158,8 +168,38 @@ void MultiViewMatcher::computeBearings(FrameFeatures& f) {
     const CameraModel& model = rig_.model(c);
     const Mat3 R_b_c = rig_.T_b_c(c).R;
     const FeatureSet& s = f.sets[c];
+    const std::vector<Vec3>& grid = bearing_grid_[c];
+    const int cols = bearing_grid_cols_[c], rows = static_cast<int>(grid.size()) / cols;
     for (int k = 0; k < s.count; ++k) {
-      f.valid[c][k] = model.unproject(Vec2(s.keypoints[k].x, s.keypoints[k].y), f.bearings[c][k]) ? 1 : 0;
+      const Vec2 uv(s.keypoints[k].x, s.keypoints[k].y);
+      Vec3& bearing = f.bearings[c][k];
+      bool ok = false;
+      const double gxf = uv.x() / kBearingGridStep, gyf = uv.y() / kBearingGridStep;
+      const int gx = static_cast<int>(std::floor(gxf)), gy = static_cast<int>(std::floor(gyf));
+      if (gx >= 0 && gy >= 0 && gx + 1 < cols && gy + 1 < rows) {
+        const Vec3& b00 = grid[gy * cols + gx];
+        const Vec3& b10 = grid[gy * cols + gx + 1];
+        const Vec3& b01 = grid[(gy + 1) * cols + gx];
+        const Vec3& b11 = grid[(gy + 1) * cols + gx + 1];
+        if (b00.squaredNorm() > 0 && b10.squaredNorm() > 0 && b01.squaredNorm() > 0 && b11.squaredNorm() > 0) {
+          const double ax = gxf - gx, ay = gyf - gy;
+          Vec3 b = ((1 - ax) * (1 - ay)) * b00 + (ax * (1 - ay)) * b10 + ((1 - ax) * ay) * b01 + (ax * ay) * b11;
+          b.normalize();
+          // One Gauss-Newton step: the smallest bearing change that moves its projection onto the keypoint.
+          Vec2 proj;
+          Mat23 J;
+          if (model.project(b, proj, &J)) {
+            const Mat2 JJt = J * J.transpose();
+            const Vec3 delta = J.transpose() * JJt.inverse() * (uv - proj);
+            if (delta.allFinite() && delta.norm() < 1e-2) {
+              bearing = (b + delta).normalized();
+              ok = true;
+            }
+          }
+        }
+      }
+      if (!ok) ok = model.unproject(uv, bearing);
+      f.valid[c][k] = ok ? 1 : 0;
       f.mv_of[c][k] = -1;
       dir_b_[c][k] = R_b_c * f.bearings[c][k];
     }

@@ -170,3 +170,29 @@ TEST(MultiViewMatcher, AbsentCameraAndNoAllocationAfterWarmUp) {
   }
   EXPECT_GT(s.features.mv_count, 50);
 }
+
+// Bearings come from an interpolated grid polished by one Gauss-Newton step: the same as the model's unprojection.
+TEST(MultiViewMatcher, BearingsAgreeWithTheCameraModel) {
+  for (const Rig& rig : {test::isecRig(), test::ring8Rig(100.0)}) {
+    const OverlapMap overlap(rig, OverlapOptions{});
+    MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, kCapacity);
+    std::mt19937 rng(24);
+    SyntheticFrame s = makeFrame(rig, 500, 300, 0.3, rng);
+    matcher.compute(s.features);
+    double worst = 0;
+    int checked = 0;
+    for (int c = 0; c < rig.size(); ++c) {
+      for (int k = 0; k < s.features.sets[c].count; ++k) {
+        const Keypoint& kp = s.features.sets[c].keypoints[k];
+        Vec3 b;
+        const bool ok = rig.model(c).unproject(Vec2(kp.x, kp.y), b);
+        ASSERT_EQ(ok, s.features.valid[c][k] != 0);
+        if (!ok) continue;
+        worst = std::max(worst, (b - s.features.bearings[c][k]).norm());
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 1000);
+    EXPECT_LT(worst, 1e-7);  // radians: 1e-4 px at these focal lengths
+  }
+}

@@ -86,6 +86,11 @@ class MultiViewMatcher {
   std::vector<std::vector<int32_t>> cell_items_;
   std::vector<std::vector<int32_t>> cell_of_;     // per keypoint
   std::vector<std::vector<Vec3>> dir_b_;          // per keypoint: bearing rotated into the body frame
+  // Per camera: bearings on a pixel grid (zero where the model has none); a keypoint's bearing is interpolated
+  // and polished with one Gauss-Newton step on the projection instead of iterative undistortion.
+  static constexpr int kBearingGridStep = 8;
+  std::vector<std::vector<Vec3>> bearing_grid_;
+  std::vector<int> bearing_grid_cols_;
 
   // Per pair: camera j's keypoints sorted by the angle of their epipolar plane about the baseline, and
   // the candidate cells of the current cell of camera i marked with a stamp.
