@@ -10,23 +10,23 @@ namespace mcslam {
 
 namespace {
 
-double sigmaOf(const Keypoint& kp, float scale_factor) { return std::pow(scale_factor, kp.octave); }
 
 // Angle from the optical axis to the farthest image corner.
 double halfFieldOfView(const CameraModel& m) {
   double best = 0;
-  for (const Vec2 c : {Vec2(0, 0), Vec2(m.width() - 1, 0), Vec2(0, m.height() - 1), Vec2(m.width() - 1, m.height() - 1)}) {
+  for (const Vec2& c : {Vec2(0, 0), Vec2(m.width() - 1, 0), Vec2(0, m.height() - 1), Vec2(m.width() - 1, m.height() - 1)}) {
     Vec3 b;
     if (m.unproject(c, b)) best = std::max(best, std::acos(std::clamp(b.z(), -1.0, 1.0)));
   }
   return best;
 }
 
-backend::WindowCapacity windowCapacity(const OdometryOptions& o, const Map& map) {
+// Exact bounds: every keypoint of a window keyframe observes at most one landmark.
+backend::WindowCapacity windowCapacity(const OdometryOptions& o, const Map& map, int cameras, int features_per_camera) {
   backend::WindowCapacity cap;
   cap.max_keyframes = o.window_keyframes;
-  cap.max_landmarks = map.landmarkCapacity();
-  cap.max_observations = std::min(4 * cap.max_landmarks * o.window_keyframes, 1 << 22);
+  cap.max_observations = (o.window_keyframes + 1) * cameras * features_per_camera;  // +1: the keyframe being added
+  cap.max_landmarks = std::min(map.landmarkCapacity(), cap.max_observations);
   return cap;
 }
 
@@ -56,7 +56,7 @@ LocalMapper::LocalMapper(const Rig& rig, const OdometryOptions& options, Map& ma
   tri_kf_.resize(max_obs);
   outliers_.resize(static_cast<std::size_t>(cams) * max_features_per_camera * options.window_keyframes);
   if (options.backend) {
-    solver_ = std::make_unique<backend::SlidingWindowSolver>(rig, windowCapacity(options, map), solverOptions(options, monocular_));
+    solver_ = std::make_unique<backend::SlidingWindowSolver>(rig, windowCapacity(options, map, rig.size(), max_features_per_camera), solverOptions(options, monocular_));
   }
 }
 
@@ -68,7 +68,7 @@ void LocalMapper::reset() {
     // it happens only when tracking was lost, never per frame.
     const Rig refined = solver_->refinedRig();
     solver_.reset();
-    solver_ = std::make_unique<backend::SlidingWindowSolver>(refined, windowCapacity(options_, map_),
+    solver_ = std::make_unique<backend::SlidingWindowSolver>(refined, windowCapacity(options_, map_, rig_.size(), capacity_),
                                                              solverOptions(options_, monocular_));
   }
   std::fill(touched_flag_.begin(), touched_flag_.end(), 0);
@@ -189,7 +189,7 @@ void LocalMapper::linkMultiViewPartners(int slot, const FrameFeatures& frame) {
       Vec2 uv;
       const Vec3 p_c = (kf.T_w_b * rig_.T_b_c(ref.cam)).inverse() * l.p_w;
       if (!rig_.model(ref.cam).project(p_c, uv)) continue;
-      const double e = (uv - Vec2(kp.x, kp.y)).norm() / sigmaOf(kp, options_.scale_factor);
+      const double e = (uv - Vec2(kp.x, kp.y)).norm() / octave_scale_[kp.octave];
       if (e * e < 5.991 && map_.addObservation(lm, slot, ref.cam, ref.index)) touch(lm);
     }
   }
@@ -265,7 +265,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
             const int ob = set1.keypoints[b].octave;
             if (std::abs(ob - oa) > 2) return;
             const Vec3 d1 = T_w_c1.R * ko.features.bearings[c1][b];
-            if (std::abs(n.dot(d1)) > kEpipolarPx * std::pow(options_.scale_factor, ob) / f1) return;
+            if (std::abs(n.dot(d1)) > kEpipolarPx * octave_scale_[ob] / f1) return;
             const int d = hammingDistance(set2.descriptors[a], set1.descriptors[b]);
             if (d < best) {
               second = best;
@@ -325,7 +325,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
           o.T_f_c = k.T_w_b * rig_.T_b_c(c);
           o.uv = Vec2(key.x, key.y);
           o.bearing = k.features.bearings[c][idx];
-          o.sigma_px = sigmaOf(key, options_.scale_factor);
+          o.sigma_px = octave_scale_[key.octave];
           tri_refs_[n] = KeypointRef{static_cast<int16_t>(c), idx};
           tri_kf_[n] = kf_slot;
           ++n;
@@ -379,7 +379,7 @@ bool LocalMapper::optimize(int slot) {
       Landmark& l = map_.landmark(lm);
       if (l.in_backend) {
         const Keypoint& kp = kf.features.sets[c].keypoints[k];
-        solver_->addObservation(kf.id, lm, c, Vec2(kp.x, kp.y), sigmaOf(kp, options_.scale_factor));
+        solver_->addObservation(kf.id, lm, c, Vec2(kp.x, kp.y), octave_scale_[kp.octave]);
         continue;
       }
       if (l.frozen) continue;
@@ -391,7 +391,7 @@ bool LocalMapper::optimize(int slot) {
         const Keyframe& ok = map_.keyframe(l.obs[o].keyframe);
         if (!ok.in_backend) continue;
         const Keypoint& kp = ok.features.sets[l.obs[o].cam].keypoints[l.obs[o].kp];
-        solver_->addObservation(ok.id, lm, l.obs[o].cam, Vec2(kp.x, kp.y), sigmaOf(kp, options_.scale_factor));
+        solver_->addObservation(ok.id, lm, l.obs[o].cam, Vec2(kp.x, kp.y), octave_scale_[kp.octave]);
       }
     }
   }

@@ -317,7 +317,7 @@ int Odometry::poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool
       o.pixel = Vec2(kp.x, kp.y);
       o.ray = bodyRay(rig_, c, frame.bearings[c][k]);
       o.point_w = map_.landmark(lm).p_w;
-      o.sigma_px = std::pow(options_.scale_factor, kp.octave);
+      o.sigma_px = octave_scale_[kp.octave];
       observation_refs_[n] = KeypointRef{static_cast<int16_t>(c), k};
       ++n;
     }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "mcslam/features/octave_scales.hpp"
+
 namespace mcslam {
 
 void FrameMatches::allocate(int cameras, int capacity, int max_landmarks) {
@@ -55,6 +57,7 @@ int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T
   const int cams = frame.cameras();
   for (int c = 0; c < cams; ++c) T_c_w_[c] = (T_w_b * rig_.T_b_c(c)).inverse();
   const float log_scale = std::log(p.scale_factor);
+  const OctaveScales scales(p.scale_factor);
   int made = 0;
   for (int i = 0; i < n; ++i) {
     const int lm = slots[i];
@@ -75,7 +78,7 @@ int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T
         predicted = std::clamp(static_cast<int>(std::ceil(std::log(l.max_distance / dist) / log_scale)), 0, p.levels - 1);
       }
       visible = true;
-      const double radius = p.radius_px * std::pow(p.scale_factor, predicted);
+      const double radius = p.radius_px * scales[predicted];
       const double r2 = radius * radius;
       const FeatureSet& set = frame.sets[c];
       int best = 257, second = 257, best_kp = -1, best_octave = 0, second_octave = 0;

@@ -41,6 +41,10 @@ double trueDepth(const sim::DepthImage& depth, double x, double y, double estima
   return std::abs(estimate - lo) < std::abs(estimate - hi) ? lo : hi;
 }
 
+// Points whose own depth sigma is at most 6%: those that a 2% check can judge (the odometry admits up to its
+// landmark bound, 15% by default, and refines them in the back-end).
+constexpr double kWellKnownDepthSigma = 0.06;
+
 DepthStats checkFrame(sim::Simulation& sim, int frame) {
   const std::vector<int> front = {0, 1, 2, 3, 4};
   const Rig rig = sim.rig().subset(front);  // keeps the body frame: camera c here is camera c of the preset
@@ -55,7 +59,7 @@ DepthStats checkFrame(sim::Simulation& sim, int frame) {
   DepthStats s;
   for (int t = 0; t < f.mv_count; ++t) {
     const MultiViewFeature& mv = f.mv[t];
-    if (!mv.has_point || mv.relative_depth_sigma > config.odometry.landmark_max_depth_sigma) continue;
+    if (!mv.has_point || mv.relative_depth_sigma > kWellKnownDepthSigma) continue;
     const KeypointRef& ref = f.mv_refs[mv.first];
     const Keypoint& kp = f.sets[ref.cam].keypoints[ref.index];
     const double z = (rig.T_b_c(ref.cam).inverse() * mv.p_b).z();

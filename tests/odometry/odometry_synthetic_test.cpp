@@ -79,7 +79,9 @@ TEST(OdometrySynthetic, FiveOverlappingCameras) {
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_EQ(r.stats.initializations, 1u);
   EXPECT_LT(r.ate, 0.05);
-  if (alloc::available()) EXPECT_EQ(r.allocations_after_warmup, 0u);  // keyframes, mapping and back-end included
+  if (alloc::available()) {
+    EXPECT_EQ(r.allocations_after_warmup, 0u);  // keyframes, mapping and back-end included
+  }
 }
 
 TEST(OdometrySynthetic, Stereo) {
@@ -87,7 +89,9 @@ TEST(OdometrySynthetic, Stereo) {
   const RunResult r = runSequence(isec().subset({1, 2}), so, false);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_LT(r.ate, 0.08);
-  if (alloc::available()) EXPECT_EQ(r.allocations_after_warmup, 0u);
+  if (alloc::available()) {
+    EXPECT_EQ(r.allocations_after_warmup, 0u);
+  }
 }
 
 TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
@@ -102,5 +106,7 @@ TEST(OdometrySynthetic, OneCameraUpToScale) {
   const RunResult r = runSequence(isec().subset({2}), so, true);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_GT(r.stats.tracking, 150u);
-  if (alloc::available()) EXPECT_EQ(r.allocations_after_warmup, 0u);
+  if (alloc::available()) {
+    EXPECT_EQ(r.allocations_after_warmup, 0u);
+  }
 }

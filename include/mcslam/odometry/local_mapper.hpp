@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "mcslam/features/octave_scales.hpp"
 #include "mcslam/backend/sliding_window_solver.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
@@ -70,6 +71,7 @@ class LocalMapper {
   std::vector<int32_t> tri_kf_;        // keyframe slot of each tri_obs_ entry
   std::vector<backend::ObservationKey> outliers_;
   int capacity_;
+  OctaveScales octave_scale_{options_.scale_factor};
   bool monocular_ = false;
   double last_backend_ms_ = 0;
   uint64_t backend_solves_ = 0;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "mcslam/features/octave_scales.hpp"
 #include "mcslam/backend/sliding_window_solver.hpp"
 #include "mcslam/geometry/absolute_pose_ransac.hpp"
 #include "mcslam/geometry/pose_refinement.hpp"
@@ -88,6 +89,7 @@ class Odometry {
   std::vector<int32_t> last_tracked_;          // landmark slots tracked in the previous frame
   int last_tracked_count_ = 0;
   int last_coarse_inliers_ = 0;  // RANSAC inliers of the previous frame's coarse pose
+  OctaveScales octave_scale_{options_.scale_factor};
 
   bool initialized_ = false;
   bool have_velocity_ = false;

@@ -37,7 +37,10 @@ struct OdometryOptions {
   int init_min_matches = 60;
 
   // Mapping.
-  double landmark_max_depth_sigma = 0.06;  // multi-view points become landmarks below this relative depth sigma
+  // Multi-view points become landmarks below this relative depth sigma: the same bar as points triangulated
+  // across keyframes (the back-end refines both); a stricter one left distant scenes seen by two cameras with
+  // too few points to start from.
+  double landmark_max_depth_sigma = 0.15;
   int temporal_keyframes = 5;            // previous keyframes searched for new points (newest first)
   TriangulationOptions new_points;       // acceptance of new points triangulated across keyframes
   int cull_min_visible = 8;              // frames a landmark must have been predicted before its ratio counts
