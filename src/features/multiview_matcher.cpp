@@ -47,41 +47,11 @@ namespace {
 // near the epipole a pixel-sized gate spans a wide range of plane angles.
 constexpr double kNearEpipoleSine = 0.5;
 
-inline int popcountPortable(uint64_t x) {
-  x = x - ((x >> 1) & 0x5555555555555555ull);
-  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
-  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
-  return static_cast<int>((x * 0x0101010101010101ull) >> 56);
-}
-
-void hammingBatchPortable(const Descriptor& a, const Descriptor* set, const int32_t* index, int n, int16_t* out) {
-  for (int k = 0; k < n; ++k) {
-    const Descriptor& b = set[index[k]];
-    out[k] = static_cast<int16_t>(popcountPortable(a[0] ^ b[0]) + popcountPortable(a[1] ^ b[1]) +
-                                  popcountPortable(a[2] ^ b[2]) + popcountPortable(a[3] ^ b[3]));
-  }
-}
-
-// The build targets generic x86-64 (no -march): the POPCNT instruction is used only where the CPU has it.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-__attribute__((target("popcnt"))) void hammingBatchPopcnt(const Descriptor& a, const Descriptor* set,
-                                                          const int32_t* index, int n, int16_t* out) {
-  for (int k = 0; k < n; ++k) {
-    const Descriptor& b = set[index[k]];
-    out[k] = static_cast<int16_t>(__builtin_popcountll(a[0] ^ b[0]) + __builtin_popcountll(a[1] ^ b[1]) +
-                                  __builtin_popcountll(a[2] ^ b[2]) + __builtin_popcountll(a[3] ^ b[3]));
-  }
-}
-bool cpuHasPopcnt() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("popcnt");
-}
-#else
-void hammingBatchPopcnt(const Descriptor& a, const Descriptor* set, const int32_t* index, int n, int16_t* out) {
+// Hamming distances of one descriptor against candidates, in a batch (POPCNT comes from the build, see
+// CMakeLists.txt).
+void hammingBatch(const Descriptor& a, const Descriptor* set, const int32_t* index, int n, int16_t* out) {
   for (int k = 0; k < n; ++k) out[k] = static_cast<int16_t>(hammingDistance(a, set[index[k]]));
 }
-bool cpuHasPopcnt() { return true; }
-#endif
 
 }  // namespace
 
@@ -90,9 +60,7 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
     : rig_(rig), overlap_(overlap), options_(options), capacity_(max_features_per_camera) {
   const int n = rig.size();
   if (n > 64) throw InputError("multi-view features support at most 64 cameras per rig");
-  hamming_batch_ = cpuHasPopcnt() ? &hammingBatchPopcnt : &hammingBatchPortable;
   for (int o = 0; o < kMaxOctaves; ++o) {
-    sigma_[o] = std::pow(static_cast<double>(options_.octave_scale), o);
     same_px2_[o] = (options_.duplicate_px * sigma_[o]) * (options_.duplicate_px * sigma_[o]);
   }
   min_metric_views_ = options_.min_metric_views;
@@ -370,7 +338,7 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
         if (perp.dot(dir_b_[j][b]) > 0) consider(b);
       }
       if (candidates == 0) continue;
-      hamming_batch_(si.descriptors[a], sj.descriptors.data(), candidate_b_.data(), candidates,
+      hammingBatch(si.descriptors[a], sj.descriptors.data(), candidate_b_.data(), candidates,
                      candidate_dist_.data());
       int best = 257, best_b = -1;
       for (int c = 0; c < candidates; ++c) {

@@ -8,6 +8,7 @@
 
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/features/frame_features.hpp"
+#include "mcslam/features/octave_scales.hpp"
 #include "mcslam/features/overlap_map.hpp"
 #include "mcslam/geometry/triangulation.hpp"
 
@@ -66,19 +67,14 @@ class MultiViewMatcher {
   void finishTrack(FrameFeatures& f, int first, int size);
   int find(int node);
 
-  // Descriptor distances of one keypoint against a list of keypoints (popcnt or portable, chosen at start).
-  using HammingBatch = void (*)(const Descriptor& a, const Descriptor* set, const int32_t* index, int n,
-                                int16_t* out);
-
   const Rig& rig_;
   const OverlapMap& overlap_;
   MultiViewOptions options_;
   int capacity_;
   MultiViewStats stats_;
-  HammingBatch hamming_batch_ = nullptr;
   static constexpr int kMaxOctaves = 32;
   double same_px2_[kMaxOctaves] = {};  // (duplicate_px * sigma(octave))^2
-  double sigma_[kMaxOctaves] = {};     // octave_scale^octave
+  OctaveScales sigma_{options_.octave_scale};  // octave_scale^octave
   int min_metric_views_ = 2;
 
   // Keypoints bucketed by cell, per camera (counting sort).

@@ -3,17 +3,14 @@
 // in profiles.
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace mcslam {
 
 class OctaveScales {
  public:
   explicit OctaveScales(double factor = 1.2) {
-    double s = 1.0;
-    for (double& v : scale_) {
-      v = s;
-      s *= factor;
-    }
+    for (int o = 0; o < kMaxOctaves; ++o) scale_[o] = std::pow(factor, o);
   }
   double operator[](int octave) const { return scale_[std::clamp(octave, 0, kMaxOctaves - 1)]; }
 
