@@ -1,13 +1,12 @@
 #include "sources/dataset_source.hpp"
 
-#include <time.h>
-
 #include <cstring>
 
 #include <spdlog/spdlog.h>
 
 #include "mcslam/core/error.hpp"
 #include "realtime/scheduling.hpp"
+#include "sources/replay_pacing.hpp"
 
 namespace mcslam::platform {
 
@@ -17,11 +16,6 @@ DatasetOptions optionsOf(const DaemonConfig& c) {
   o.calibration_override = c.calibration;
   o.cameras = c.dataset.cameras;
   return o;
-}
-
-void sleepUntil(int64_t mono_ns) {
-  timespec ts{static_cast<time_t>(mono_ns / 1000000000), static_cast<long>(mono_ns % 1000000000)};
-  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
 }
 
 void copyImage(const Image& from, Image& to) {
@@ -83,31 +77,8 @@ void DatasetSource::stop() {
 
 // Waits until frame i is due. False when stopping.
 bool DatasetSource::waitTurn(std::size_t i, uint64_t loop, int64_t start_mono, uint64_t& trigger_index) {
-  if (software_) {
-    while (!stop_.load(std::memory_order_relaxed)) {
-      const uint32_t ticket = trigger_bell_.ticket();
-      // Serve the newest trigger; like a busy camera, the replay skips triggers it could not keep up with.
-      const uint64_t fired = triggered_.load(std::memory_order_acquire);
-      if (fired > trigger_index) {
-        trigger_index = fired - 1;
-        return true;
-      }
-      trigger_bell_.wait(ticket, 100000000);
-    }
-    return false;
-  }
-  if (cfg_.rate == "fastest") {
-    // Lossless: at most two frames in flight (one processed, one waiting). Should a frame vanish on
-    // the way (e.g. assembled together with another), go on after 2 s rather than wait forever.
-    const int64_t give_up = monotonicNowNs() + 2000000000;
-    while (!stop_.load(std::memory_order_relaxed) &&
-           emitted_.load(std::memory_order_relaxed) >= processed_.load(std::memory_order_acquire) + 2 &&
-           monotonicNowNs() < give_up) {
-      timespec ts{0, 200000};
-      clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
-    }
-    return !stop_.load(std::memory_order_relaxed);
-  }
+  if (software_) return waitForNewestTrigger(stop_, triggered_, trigger_bell_, trigger_index, trigger_index);
+  if (cfg_.rate == "fastest") return waitForPipeline(stop_, emitted_, processed_);
   const auto& frames = dataset_.frames();
   const int64_t offset = static_cast<int64_t>(loop) * loop_period_ns_ + (frames[i].t - frames.front().t);
   const int64_t due = start_mono + static_cast<int64_t>(static_cast<double>(offset) / cfg_.speed);

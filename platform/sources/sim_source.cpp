@@ -1,13 +1,12 @@
 #include "sources/sim_source.hpp"
 
-#include <time.h>
-
 #include <cstdio>
 
 #include <spdlog/spdlog.h>
 
 #include "mcslam/core/error.hpp"
 #include "realtime/scheduling.hpp"
+#include "sources/replay_pacing.hpp"
 
 namespace mcslam::platform {
 
@@ -23,11 +22,6 @@ sim::SimulationConfig simulationConfig(const SimSourceConfig& s) {
   c.render.threads = s.render_threads;
   c.render.anti_aliasing = s.anti_aliasing;
   return c;
-}
-
-void sleepUntil(int64_t mono_ns) {
-  timespec ts{static_cast<time_t>(mono_ns / 1000000000), static_cast<long>(mono_ns % 1000000000)};
-  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
 }
 }  // namespace
 
@@ -71,29 +65,11 @@ void SimSource::health(char* out, std::size_t size) const {
 }
 
 bool SimSource::waitTurn(uint64_t next, int64_t start_mono, uint64_t& frame) {
-  if (software_) {
-    while (!stop_.load(std::memory_order_relaxed)) {
-      const uint32_t ticket = trigger_bell_.ticket();
-      const uint64_t fired = triggered_.load(std::memory_order_acquire);
-      if (fired > next) {
-        frame = fired - 1;  // the newest trigger; the ones missed while rendering are skipped
-        return true;
-      }
-      trigger_bell_.wait(ticket, 100000000);
-    }
-    return false;
-  }
+  // The newest trigger; the ones missed while rendering are skipped.
+  if (software_) return waitForNewestTrigger(stop_, triggered_, trigger_bell_, next, frame);
   if (cfg_.pace == "fastest") {
-    // Lossless: at most two frames in flight (as the dataset replay); go on after 2 s should one vanish.
-    const int64_t give_up = monotonicNowNs() + 2000000000;
-    while (!stop_.load(std::memory_order_relaxed) &&
-           emitted_.load(std::memory_order_relaxed) >= processed_.load(std::memory_order_acquire) + 2 &&
-           monotonicNowNs() < give_up) {
-      timespec ts{0, 200000};
-      clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
-    }
     frame = next;
-    return !stop_.load(std::memory_order_relaxed);
+    return waitForPipeline(stop_, emitted_, processed_);
   }
   const double period_ns = 1e9 / cfg_.rate_hz;
   while (!stop_.load(std::memory_order_relaxed)) {
