@@ -40,26 +40,18 @@ void printComparison(const Rig& a, const Rig& b, bool json) {
   if (a.size() != b.size()) {
     throw InputError("the calibrations have " + std::to_string(a.size()) + " and " + std::to_string(b.size()) + " cameras");
   }
-  JsonWriter* j = nullptr;
-  JsonWriter writer(std::cout);
-  if (json) {
-    j = &writer;
-    j->beginObject().key("cameras").beginArray();
-  } else {
-    std::printf("camera  translation (mm)  rotation (deg)   (poses relative to each calibration's camera 0)\n");
-  }
+  JsonWriter j(std::cout);
+  if (json) j.beginObject().key("cameras").beginArray();
+  else std::printf("camera  translation (mm)  rotation (deg)   (poses relative to each calibration's camera 0)\n");
   for (int c = 0; c < a.size(); ++c) {
     const SE3 pa = a.T_b_c(0).inverse() * a.T_b_c(c);
     const SE3 pb = b.T_b_c(0).inverse() * b.T_b_c(c);
     const double dt = (pa.t - pb.t).norm();
     const double dr = rotationAngle(pa.R, pb.R) * 180.0 / M_PI;
-    if (j) {
-      j->beginObject().key("index").value(c).key("translation_m").value(dt).key("rotation_deg").value(dr).endObject();
-    } else {
-      std::printf("  cam%-3d %12.2f  %14.4f\n", c, dt * 1e3, dr);
-    }
+    if (json) j.beginObject().key("index").value(c).key("translation_m").value(dt).key("rotation_deg").value(dr).endObject();
+    else std::printf("  cam%-3d %12.2f  %14.4f\n", c, dt * 1e3, dr);
   }
-  if (j) j->endArray().endObject();
+  if (json) j.endArray().endObject();
 }
 
 }  // namespace mcslam::rigtool
