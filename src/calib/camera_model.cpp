@@ -66,7 +66,7 @@ void CameraModel::computeValidDomain() {
     // Beyond the image the polynomial was never calibrated and grows wildly: keep the domain to twice
     // the radius the image corners reach.
     double corner_r2 = 0;
-    for (const Vec2 c : {Vec2(-0.5, -0.5), Vec2(width_ - 0.5, -0.5), Vec2(-0.5, height_ - 0.5),
+    for (const Vec2& c : {Vec2(-0.5, -0.5), Vec2(width_ - 0.5, -0.5), Vec2(-0.5, height_ - 0.5),
                          Vec2(width_ - 0.5, height_ - 0.5)}) {
       Vec3 b;
       if (unproject(c, b) && b.z() > 0) corner_r2 = std::max(corner_r2, b.head<2>().squaredNorm() / (b.z() * b.z()));
