@@ -1,0 +1,195 @@
+// Export into the three layouts, checked by reading the output back with our own readers: the same rig,
+// frames, images and ground truth must come out (a round trip through each layout).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dataset_test_util.hpp"
+#include "mcslam/core/error.hpp"
+#include "mcslam/dataset/dataset.hpp"
+#include "mcslam/dataset/dataset_export.hpp"
+
+using namespace mcslam;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kFrames = 5;
+
+SE3 groundTruthPose(int i) {
+  return SE3(Eigen::AngleAxisd(0.1 * i, Vec3(0.2, 0.3, 1).normalized()).toRotationMatrix(), Vec3(0.5 * i, -0.2 * i, 0.05));
+}
+
+// An ASL dataset of `rig` with kFrames rig frames at 10 Hz (camera c's image of frame i has value 10 i + c) and
+// ground truth at every frame; `skip_camera` of frame 2 is left out when >= 0.
+std::string writeAsl(const test::TempDir& dir, const Rig& rig, int skip_camera = -1) {
+  const std::string root = (dir.path() / "asl").string();
+  AslDatasetWriter w(root, rig);
+  Trajectory gt;
+  for (int i = 0; i < kFrames; ++i) {
+    const Timestamp t = 1000000000 + i * 100000000LL;
+    for (int c = 0; c < rig.size(); ++c) {
+      if (i == 2 && c == skip_camera) continue;
+      w.writeImage(c, t, test::FlatImage(static_cast<uint8_t>(10 * i + c)).image.view());
+    }
+    gt.push_back({t, groundTruthPose(i)});
+  }
+  w.writeGroundTruth(gt);
+  w.close();
+  return root;
+}
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+void expectSamePose(const SE3& a, const SE3& b, double tol) {
+  EXPECT_LT((a.t - b.t).norm(), tol);
+  EXPECT_LT(Eigen::AngleAxisd(a.R.transpose() * b.R).angle(), tol);
+}
+
+// Same cameras (intrinsics and poses in the body frame), same frames and image bytes, same ground truth.
+void expectSameDataset(const Dataset& a, const Dataset& b, double tol) {
+  ASSERT_EQ(a.rig().size(), b.rig().size());
+  for (int c = 0; c < a.rig().size(); ++c) {
+    EXPECT_NEAR(a.rig().model(c).fx(), b.rig().model(c).fx(), tol);
+    EXPECT_NEAR(a.rig().model(c).cy(), b.rig().model(c).cy(), tol);
+    EXPECT_EQ(a.rig().model(c).width(), b.rig().model(c).width());
+    expectSamePose(a.rig().T_b_c(c), b.rig().T_b_c(c), tol);
+  }
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (int c = 0; c < a.rig().size(); ++c) {
+      ASSERT_EQ(a.frames()[i].image_paths[c].empty(), b.frames()[i].image_paths[c].empty()) << "frame " << i;
+      if (a.frames()[i].image_paths[c].empty()) continue;
+      EXPECT_EQ(readBytes(a.frames()[i].image_paths[c]), readBytes(b.frames()[i].image_paths[c])) << "frame " << i;
+    }
+  }
+  ASSERT_TRUE(a.groundTruth() && b.groundTruth());
+  ASSERT_EQ(a.groundTruth()->size(), b.groundTruth()->size());
+  for (std::size_t i = 0; i < a.groundTruth()->size(); ++i) {
+    EXPECT_EQ((*a.groundTruth())[i].t, (*b.groundTruth())[i].t);
+    expectSamePose((*a.groundTruth())[i].T_w_b, (*b.groundTruth())[i].T_w_b, tol);
+  }
+}
+
+}  // namespace
+
+TEST(DatasetExport, EurocRoundTripKeepsRigFramesImagesAndGroundTruth) {
+  test::TempDir dir("export_euroc");
+  Rig rig = test::smallRig(3);
+  rig.cameras[2].T_b_c = SE3(Eigen::AngleAxisd(0.3, Vec3::UnitY()).toRotationMatrix(), Vec3(0.2, 0.01, -0.03));
+  rig.T_b_imu = SE3(Eigen::AngleAxisd(1.2, Vec3::UnitX()).toRotationMatrix(), Vec3(0.05, -0.1, 0.02));
+  const Dataset asl = Dataset::open(writeAsl(dir, rig));
+  const DatasetExportReport r = exportDataset(asl, DatasetLayoutKind::Euroc, dir.file("euroc"));
+  EXPECT_EQ(r.frames_written, static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(r.images_written, static_cast<std::size_t>(3 * kFrames));
+  EXPECT_EQ(r.ground_truth_poses, static_cast<std::size_t>(kFrames));
+  const Dataset euroc = Dataset::open(dir.file("euroc"));
+  EXPECT_EQ(euroc.format(), "euroc");
+  expectSameDataset(asl, euroc, 1e-8);
+  // The IMU is EuRoC's body: ground truth went through T_BS and came back.
+  ASSERT_TRUE(euroc.rig().T_b_imu);
+  expectSamePose(*euroc.rig().T_b_imu, *rig.T_b_imu, 1e-8);
+}
+
+TEST(DatasetExport, AslRoundTripOfACameraSubsetMovesTheBodyToItsFirstCamera) {
+  test::TempDir dir("export_asl");
+  const Rig rig = test::smallRig(3);
+  const std::string src = writeAsl(dir, rig);
+  DatasetOptions subset;
+  subset.cameras = {1, 2};
+  const Dataset in = Dataset::open(src, subset);
+  exportDataset(in, DatasetLayoutKind::Asl, dir.file("asl_out"));
+  const Dataset out = Dataset::open(dir.file("asl_out"));
+  ASSERT_EQ(out.rig().size(), 2);
+  // The written cam0 is the source's cam1, and it is the body now.
+  expectSamePose(out.rig().T_b_c(0), SE3(), 1e-12);
+  expectSamePose(out.rig().T_b_c(1), SE3(Mat3::Identity(), Vec3(0.1, 0, 0)), 1e-12);
+  EXPECT_EQ(readBytes(in.frames()[3].image_paths[1]), readBytes(out.frames()[3].image_paths[1]));
+  // Ground truth follows the body: T_w_b' = T_w_b * T_b_cam1.
+  ASSERT_TRUE(out.groundTruth());
+  expectSamePose((*out.groundTruth())[3].T_w_b, groundTruthPose(3) * rig.T_b_c(1), 1e-9);
+}
+
+TEST(DatasetExport, KittiRoundTripOfARectifiedRig) {
+  test::TempDir dir("export_kitti");
+  const Dataset asl = Dataset::open(writeAsl(dir, test::smallRig(2)));
+  const DatasetExportReport r = exportDataset(asl, DatasetLayoutKind::Kitti, dir.file("kitti"));
+  EXPECT_EQ(r.frames_written, static_cast<std::size_t>(kFrames));
+  EXPECT_TRUE(r.warnings.empty());
+  const Dataset kitti = Dataset::open(dir.file("kitti"));
+  EXPECT_EQ(kitti.format(), "kitti");
+  ASSERT_EQ(kitti.rig().size(), 2);
+  expectSamePose(kitti.rig().T_b_c(1), SE3(Mat3::Identity(), Vec3(0.1, 0, 0)), 1e-9);
+  ASSERT_EQ(kitti.size(), asl.size());
+  for (std::size_t i = 0; i < kitti.size(); ++i) {
+    EXPECT_EQ(kitti.frames()[i].t, asl.frames()[i].t);  // times.txt keeps the stamps to the nanosecond
+    EXPECT_EQ(readBytes(kitti.frames()[i].image_paths[1]), readBytes(asl.frames()[i].image_paths[1]));
+  }
+  // KITTI poses start at the identity; relative motion is unchanged.
+  ASSERT_TRUE(kitti.groundTruth());
+  expectSamePose((*kitti.groundTruth())[0].T_w_b, SE3(), 1e-9);
+  expectSamePose((*kitti.groundTruth())[4].T_w_b, groundTruthPose(0).inverse() * groundTruthPose(4), 1e-8);
+}
+
+TEST(DatasetExport, KittiLeavesOutRigFramesWithAMissingImageAndSaysSo) {
+  test::TempDir dir("export_kitti_gap");
+  const Dataset asl = Dataset::open(writeAsl(dir, test::smallRig(2), /*skip_camera=*/1));
+  const DatasetExportReport r = exportDataset(asl, DatasetLayoutKind::Kitti, dir.file("kitti"));
+  EXPECT_EQ(r.frames_written, static_cast<std::size_t>(kFrames - 1));
+  EXPECT_EQ(r.frames_skipped, 1u);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings[0].find("no image"), std::string::npos) << r.warnings[0];
+  EXPECT_EQ(Dataset::open(dir.file("kitti")).size(), static_cast<std::size_t>(kFrames - 1));
+}
+
+TEST(DatasetExport, KittiRefusesDistortedOrTurnedCamerasBeforeWritingAnything) {
+  test::TempDir dir("export_kitti_bad");
+  Rig distorted = test::smallRig(2);
+  distorted.cameras[1].model = CameraModel(test::kWidth, test::kHeight, 20, 20, 7.5, 5.5, Distortion::RadTan, {-0.2, 0.05, 0, 0});
+  const Dataset a = Dataset::open(writeAsl(dir, distorted));
+  try {
+    exportDataset(a, DatasetLayoutKind::Kitti, dir.file("kitti"));
+    FAIL() << "a distorted camera was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cam1: distortion radtan"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.file("kitti")));
+
+  test::TempDir dir2("export_kitti_turned");
+  Rig turned = test::smallRig(2);
+  turned.cameras[1].T_b_c.R = Eigen::AngleAxisd(0.01, Vec3::UnitY()).toRotationMatrix();
+  const Dataset b = Dataset::open(writeAsl(dir2, turned));
+  try {
+    exportDataset(b, DatasetLayoutKind::Kitti, dir2.file("kitti"));
+    FAIL() << "a turned camera was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cam1: turned 0.5730 deg"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DatasetExport, RefusesAnOutputFolderThatHoldsSomething) {
+  test::TempDir dir("export_exists");
+  const Dataset asl = Dataset::open(writeAsl(dir, test::smallRig(1)));
+  test::writeFile(dir.file("out/keep.txt"), "mine");
+  try {
+    exportDataset(asl, DatasetLayoutKind::Euroc, dir.file("out"));
+    FAIL() << "wrote into a folder that holds a file";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("already exists"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(readBytes(dir.file("out/keep.txt")), "mine");
+  EXPECT_FALSE(fs::exists(dir.file("out/mav0")));
+}
+
+TEST(DatasetExport, LayoutNames) {
+  EXPECT_EQ(parseDatasetLayout("kitti"), DatasetLayoutKind::Kitti);
+  EXPECT_STREQ(datasetLayoutName(parseDatasetLayout("euroc")), "euroc");
+  EXPECT_THROW(parseDatasetLayout("tum"), InputError);
+}

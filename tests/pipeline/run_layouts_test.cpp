@@ -1,0 +1,82 @@
+// One rendered sequence written in the three layouts mcslam reads (native ASL, EuRoC, KITTI) goes through
+// mcslam-run unchanged: the readers hand the pipeline the same rig, images and times, so the trajectories
+// agree with each other and with the ground truth each layout carries.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "mcslam/dataset/dataset.hpp"
+#include "mcslam/dataset/trajectory.hpp"
+#include "mcslam/eval/trajectory_metrics.hpp"
+#include "test_support.hpp"
+
+using namespace mcslam;
+
+namespace {
+
+constexpr int kFrames = 60;
+
+std::string bin(const std::string& tool) { return test::binPath(tool); }
+
+class RunLayouts : public ::testing::Test {
+ protected:
+  // Rendered once for the suite: a rectified stereo pair (KITTI 00's intrinsics and baseline), indoor loop start.
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>("run_layouts");
+    const std::string asl = dir_->file("asl");
+    std::string out;
+    const int code = test::runCommand(bin("mcslam-sim") + " --rig " + test::dataPath("calib/rectified_stereo_camchain.yaml") +
+                                          " --world indoor --frames " + std::to_string(kFrames) +
+                                          " --no-depth --quiet --seed 3 --out " + asl,
+                                      &out);
+    ASSERT_EQ(code, 0) << out;
+    for (const char* layout : {"euroc", "kitti"}) {
+      ASSERT_EQ(test::runCommand(bin("mcslam-dataset") + " convert " + asl + " --layout " + layout + " --out " +
+                                     dir_->file(layout), &out), 0) << out;
+    }
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+
+  static Trajectory run(const std::string& layout) {
+    const std::string traj = dir_->file(layout + ".tum");
+    std::string out;
+    EXPECT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file(layout) + " --quiet --out " + traj, &out), 0)
+        << out;
+    return readTumTrajectory(traj);
+  }
+
+  static std::unique_ptr<test::TempDir> dir_;
+};
+
+std::unique_ptr<test::TempDir> RunLayouts::dir_;
+
+double maxPositionDifference(const Trajectory& a, const Trajectory& b) {
+  double worst = 0;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) worst = std::max(worst, (a[i].T_w_b.t - b[i].T_w_b.t).norm());
+  return worst;
+}
+
+}  // namespace
+
+TEST_F(RunLayouts, EveryLayoutGivesTheSameTrajectoryAndItMatchesItsGroundTruth) {
+  const Trajectory asl = run("asl"), euroc = run("euroc"), kitti = run("kitti");
+  ASSERT_EQ(asl.size(), static_cast<std::size_t>(kFrames));
+  ASSERT_EQ(euroc.size(), asl.size());
+  ASSERT_EQ(kitti.size(), asl.size());
+  for (std::size_t i = 0; i < asl.size(); ++i) {
+    EXPECT_EQ(euroc[i].t, asl[i].t);
+    EXPECT_EQ(kitti[i].t, asl[i].t);
+  }
+  // Same inputs up to the last digits of the written calibration: the same trajectory (to well under a millimetre).
+  EXPECT_LT(maxPositionDifference(asl, euroc), 1e-4);
+  EXPECT_LT(maxPositionDifference(asl, kitti), 1e-4);
+  // And each matches the ground truth its own layout carries (TUM body poses, EuRoC state csv, KITTI poses.txt).
+  for (const char* layout : {"asl", "euroc", "kitti"}) {
+    const Dataset ds = Dataset::open(dir_->file(layout));
+    ASSERT_TRUE(ds.groundTruth()) << layout;
+    const ApeResult ape = computeApe(*ds.groundTruth(), layout == std::string("asl") ? asl : layout == std::string("euroc") ? euroc : kitti, {});
+    EXPECT_EQ(ape.errors.size(), static_cast<std::size_t>(kFrames)) << layout;
+    EXPECT_GT(ape.data.ref_path_length, 2.0) << layout;  // the robot really moved
+    EXPECT_LT(ape.stats.rmse, 0.02) << layout << ": ATE " << ape.stats.rmse << " m over " << ape.data.ref_path_length << " m";
+  }
+}
