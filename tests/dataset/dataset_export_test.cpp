@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "dataset_test_util.hpp"
 #include "mcslam/core/error.hpp"
@@ -41,13 +39,6 @@ std::string writeAsl(const test::TempDir& dir, const Rig& rig, int skip_camera =
   return root;
 }
 
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
-
 void expectSamePose(const SE3& a, const SE3& b, double tol) {
   EXPECT_LT((a.t - b.t).norm(), tol);
   EXPECT_LT(Eigen::AngleAxisd(a.R.transpose() * b.R).angle(), tol);
@@ -67,7 +58,7 @@ void expectSameDataset(const Dataset& a, const Dataset& b, double tol) {
     for (int c = 0; c < a.rig().size(); ++c) {
       ASSERT_EQ(a.frames()[i].image_paths[c].empty(), b.frames()[i].image_paths[c].empty()) << "frame " << i;
       if (a.frames()[i].image_paths[c].empty()) continue;
-      EXPECT_EQ(readBytes(a.frames()[i].image_paths[c]), readBytes(b.frames()[i].image_paths[c])) << "frame " << i;
+      EXPECT_EQ(test::readFile(a.frames()[i].image_paths[c]), test::readFile(b.frames()[i].image_paths[c])) << "frame " << i;
     }
   }
   ASSERT_TRUE(a.groundTruth() && b.groundTruth());
@@ -111,7 +102,7 @@ TEST(DatasetExport, AslRoundTripOfACameraSubsetMovesTheBodyToItsFirstCamera) {
   // The written cam0 is the source's cam1, and it is the body now.
   expectSamePose(out.rig().T_b_c(0), SE3(), 1e-12);
   expectSamePose(out.rig().T_b_c(1), SE3(Mat3::Identity(), Vec3(0.1, 0, 0)), 1e-12);
-  EXPECT_EQ(readBytes(in.frames()[3].image_paths[1]), readBytes(out.frames()[3].image_paths[1]));
+  EXPECT_EQ(test::readFile(in.frames()[3].image_paths[1]), test::readFile(out.frames()[3].image_paths[1]));
   // Ground truth follows the body: T_w_b' = T_w_b * T_b_cam1.
   ASSERT_TRUE(out.groundTruth());
   expectSamePose((*out.groundTruth())[3].T_w_b, groundTruthPose(3) * rig.T_b_c(1), 1e-9);
@@ -130,7 +121,7 @@ TEST(DatasetExport, KittiRoundTripOfARectifiedRig) {
   ASSERT_EQ(kitti.size(), asl.size());
   for (std::size_t i = 0; i < kitti.size(); ++i) {
     EXPECT_EQ(kitti.frames()[i].t, asl.frames()[i].t);  // times.txt keeps the stamps to the nanosecond
-    EXPECT_EQ(readBytes(kitti.frames()[i].image_paths[1]), readBytes(asl.frames()[i].image_paths[1]));
+    EXPECT_EQ(test::readFile(kitti.frames()[i].image_paths[1]), test::readFile(asl.frames()[i].image_paths[1]));
   }
   // KITTI poses start at the identity; relative motion is unchanged.
   ASSERT_TRUE(kitti.groundTruth());
@@ -184,7 +175,7 @@ TEST(DatasetExport, RefusesAnOutputFolderThatHoldsSomething) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("already exists"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(readBytes(dir.file("out/keep.txt")), "mine");
+  EXPECT_EQ(test::readFile(dir.file("out/keep.txt")), "mine");
   EXPECT_FALSE(fs::exists(dir.file("out/mav0")));
 }
 

@@ -40,7 +40,8 @@ class RunLayouts : public ::testing::Test {
   static Trajectory run(const std::string& layout) {
     const std::string traj = dir_->file(layout + ".tum");
     std::string out;
-    EXPECT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file(layout) + " --quiet --out " + traj, &out), 0)
+    EXPECT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file(layout) + " --quiet --out " + traj +
+                                   " --stats " + dir_->file(layout + ".json"), &out), 0)
         << out;
     return readTumTrajectory(traj);
   }
@@ -70,6 +71,10 @@ TEST_F(RunLayouts, EveryLayoutGivesTheSameTrajectoryAndItMatchesItsGroundTruth) 
   // Same inputs up to the last digits of the written calibration: the same trajectory (to well under a millimetre).
   EXPECT_LT(maxPositionDifference(asl, euroc), 1e-4);
   EXPECT_LT(maxPositionDifference(asl, kitti), 1e-4);
+  // The stats file says when tracking started (frame 0 initializes from the multi-view features of one frame).
+  const std::string stats = test::readFile(dir_->file("asl.json"));
+  EXPECT_NE(stats.find("\"state_changes\": [\n    {\n      \"frame\": 0,"), std::string::npos) << stats;
+  EXPECT_NE(stats.find("\"state\": \"tracking\""), std::string::npos) << stats;
   // And each matches the ground truth its own layout carries (TUM body poses, EuRoC state csv, KITTI poses.txt).
   for (const char* layout : {"asl", "euroc", "kitti"}) {
     const Dataset ds = Dataset::open(dir_->file(layout));

@@ -26,6 +26,8 @@ class TempDir {
 
 // Writes text to a file (creating folders); returns the path.
 std::string writeFile(const std::string& path, const std::string& text);
+// The whole file as bytes (empty when it cannot be read).
+std::string readFile(const std::string& path);
 
 // Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
 int runCommand(const std::string& command, std::string* output = nullptr);

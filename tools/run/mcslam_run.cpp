@@ -119,7 +119,11 @@ int main(int argc, char** argv) {
       view.present = present.get();
       PoseEstimate pose;
       pipeline.process(view, pose);
-      report.add(pose, pipeline.timing());
+      // Losing and regaining track are worth a line of their own (the stats file lists them all).
+      if (report.add(pose, pipeline.timing()) && !quiet && i > 0) {
+        std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s\n", show ? "\r\033[K" : "", i, toSeconds(pose.t),
+                     trackingStateName(pose.state));
+      }
       const bool initialized = pipeline.odometry().initialized();
       if (initialized && !was_initialized && pipeline.odometry().lastInitializationReference() >= 0) {
         report.backfill(static_cast<uint64_t>(pipeline.odometry().lastInitializationReference()), i);

@@ -8,12 +8,15 @@
 
 namespace mcslam::run {
 
-void RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
+bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
   FrameRecord r;
   r.t = pose.t;
   r.pose = pose;
   r.timing = timing;
+  const bool changed = frames_.empty() || frames_.back().pose.state != pose.state;
+  if (changed) changes_.push_back(StateChange{frames_.size(), pose.t, pose.state});
   frames_.push_back(r);
+  return changed;
 }
 
 void RunReport::backfill(uint64_t reference_index, uint64_t init_index) {
@@ -100,6 +103,16 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("not_initialized").value(state_count[static_cast<int>(TrackingState::NotInitialized)]);
   j.key("lost").value(state_count[static_cast<int>(TrackingState::Lost)]);
   j.endObject();
+  // Where tracking was lost and regained: every change of state, with its frame index and time.
+  j.key("state_changes").beginArray();
+  for (const StateChange& c : changes_) {
+    j.beginObject();
+    j.key("frame").value(static_cast<unsigned long long>(c.frame));
+    j.key("t").value(toSeconds(c.t));
+    j.key("state").value(trackingStateName(c.state));
+    j.endObject();
+  }
+  j.endArray();
   j.key("interpolated_before_initialization").value(interpolated);
   j.key("initializations").value(s.initializations);
   j.key("keyframes").value(s.keyframes);

@@ -16,9 +16,17 @@ struct FrameRecord {
   bool interpolated = false;  // filled in after a two-frame initialization
 };
 
+// A frame whose tracking state differs from the frame before (the first frame counts as one).
+struct StateChange {
+  std::size_t frame = 0;
+  Timestamp t = 0;
+  TrackingState state = TrackingState::NotInitialized;
+};
+
 class RunReport {
  public:
-  void add(const PoseEstimate& pose, const PipelineTiming& timing);
+  // Returns true when the frame's tracking state differs from the previous frame's (see stateChanges()).
+  bool add(const PoseEstimate& pose, const PipelineTiming& timing);
   // After a two-frame initialization at frame `init_index` from reference frame `reference_index`, the
   // frames in between get poses interpolated between the two (they had none of their own).
   void backfill(uint64_t reference_index, uint64_t init_index);
@@ -28,6 +36,7 @@ class RunReport {
   Trajectory trajectory() const;  // every frame with a pose
   Trajectory keyframes() const;
   const std::vector<FrameRecord>& frames() const { return frames_; }
+  const std::vector<StateChange>& stateChanges() const { return changes_; }
 
   void writeStats(const std::string& path, const SlamPipeline& pipeline, const std::string& dataset, int cameras,
                   double wall_seconds) const;
@@ -35,6 +44,7 @@ class RunReport {
  private:
   std::vector<FrameRecord> frames_;
   std::map<int64_t, StampedPose> keyframes_;
+  std::vector<StateChange> changes_;
 };
 
 }  // namespace mcslam::run
