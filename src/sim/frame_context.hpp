@@ -1,10 +1,11 @@
 #pragma once
 // State of one rendered view: the camera pose, the moving objects placed at the frame time, every primitive's
-// frame holding the camera centre, per-tile candidate lists, and the scalar shading of a surface hit.
+// frame holding the camera centre, per-tile candidate lists, and the shading of surface hits (shading.cpp).
 #include <cstdint>
 #include <vector>
 
 #include "camera_lut.hpp"
+#include "simd4.hpp"
 #include "world_data.hpp"
 
 namespace mcslam::sim {
@@ -37,8 +38,9 @@ class FrameContext {
   const detail::Prim& prim(int i) const { return i < n_static_ ? world_.prims[i] : dynamic_[i - n_static_]; }
   const float* localOrigin(int i) const { return &local_o_[3 * static_cast<std::size_t>(i)]; }
   const float* origin() const { return O_; }
-  // Camera-frame bearing -> world direction.
-  void rotate(const float b[3], float d[3]) const {
+  // Camera-frame bearing -> world direction (T: float, or f4 for four bearings).
+  template <class T>
+  void rotate(const T b[3], T d[3]) const {
     d[0] = R_[0] * b[0] + R_[1] * b[1] + R_[2] * b[2];
     d[1] = R_[3] * b[0] + R_[4] * b[1] + R_[5] * b[2];
     d[2] = R_[6] * b[0] + R_[7] * b[1] + R_[8] * b[2];
@@ -48,6 +50,11 @@ class FrameContext {
   // Linear radiance leaving the surface hit `key` at distance t along world direction d; pixel_angle (radians)
   // sets the texture filter footprint.
   float shade(uint32_t key, float t, const float d[3], float pixel_angle) const;
+  // Whether shadeQuad handles hits on surface `key` (box faces with a light map).
+  bool quadShadable(uint32_t key) const;
+  // shade() for four pixels whose centre rays all hit surface `key` (quadShadable): camera-frame bearings b,
+  // distances t_hit, pixel angles. One texture level for the four, from their mean footprint.
+  f4 shadeQuad(uint32_t key, f4 t_hit, const f4 b[3], f4 pixel_angle) const;
   // Radiance of a ray that hits nothing.
   float sky(const float d[3]) const;
 

@@ -13,6 +13,16 @@ inline uint64_t mix64(uint64_t x) {  // splitmix64 finaliser
   return x ^ (x >> 31);
 }
 
+// 32-bit finaliser (Wellons' "lowbias32"): for the per-pixel sensor noise, where mix64's two 64-bit products
+// were a visible share of the render time.
+inline uint32_t hash32(uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352dU;
+  x ^= x >> 15;
+  x *= 0x846ca68bU;
+  return x ^ (x >> 16);
+}
+
 inline uint64_t hashOf(uint64_t a, uint64_t b) { return mix64(a ^ mix64(b)); }
 inline uint64_t hashOf(uint64_t a, uint64_t b, uint64_t c) { return hashOf(hashOf(a, b), c); }
 inline uint64_t hashOf(uint64_t a, uint64_t b, uint64_t c, uint64_t d) { return hashOf(hashOf(a, b, c), d); }

@@ -20,6 +20,7 @@ MipTexture::MipTexture(int width, int height, const std::vector<uint8_t>& pixels
     Level L;
     L.w = w;
     L.h = h;
+    L.shift = __builtin_ctz(static_cast<unsigned>(w));
     L.scale = scale;
     L.offset = total;
     levels_.push_back(L);

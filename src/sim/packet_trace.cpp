@@ -5,14 +5,6 @@
 
 namespace mcslam::sim {
 
-namespace {
-
-inline f4 vmin(f4 a, f4 b) { return a < b ? a : b; }
-inline f4 vmax(f4 a, f4 b) { return a > b ? a : b; }
-inline f4 splat(float v) { return f4{v, v, v, v}; }
-
-}  // namespace
-
 void tracePacket(const FrameContext& ctx, const std::vector<Candidate>& cands, const RayPacket& rays, int& hint,
                  uint32_t keys[4], float t[4]) {
   f4 inv[3];

@@ -1,16 +1,13 @@
 #pragma once
-// Four rays at a time (GCC vector extensions: plain SSE2 on x86-64, no target-specific intrinsics): the rays of
-// four neighbouring pixels share the camera centre and the tile's candidates, so each candidate is tested
-// against all four with one set of vector operations.
+// Four rays at a time: the rays of four neighbouring pixels share the camera centre and the tile's candidates,
+// so each candidate is tested against all four with one set of vector operations.
 #include <cstdint>
 #include <vector>
 
 #include "frame_context.hpp"
+#include "simd4.hpp"
 
 namespace mcslam::sim {
-
-typedef float f4 __attribute__((vector_size(16)));
-typedef int32_t i4 __attribute__((vector_size(16)));
 
 struct RayPacket {
   f4 d[3];    // world directions (unit), x, y, z of each lane

@@ -26,7 +26,9 @@ struct Prim {
   SE3 pose() const;  // T_w_o
   void aabb(float lo[3], float hi[3]) const;
 
-  void toLocal(const float v[3], float out[3]) const {
+  // T: float, or a four-lane vector (f4) of directions.
+  template <class T>
+  void toLocal(const T v[3], T out[3]) const {
     if (aligned) {
       out[0] = v[0];
       out[1] = v[1];

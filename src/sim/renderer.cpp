@@ -1,10 +1,11 @@
 // Two passes per view, both parallel over tiles:
 //  1. visibility: per tile, the primitives whose bounds meet the tile's rays (BVH cone query, then the tile's
 //     bounding planes), sorted by distance; rays traced four at a time against them.
-//  2. shading: texture (mip level from the ray footprint) x baked irradiance. Pixels whose 8 neighbours do not
-//     all see the same face are anti-aliased by coverage: sub-pixel rays are traced and each face they hit is
-//     shaded once, weighted by its share of the samples.
-// Then the sensor model turns linear radiance into grey levels.
+//  2. shading: texture (mip level from the ray footprint) x baked irradiance, four pixels at a time where they
+//     and their neighbours all see one face. Pixels whose 8 neighbours do not all see the same face are
+//     anti-aliased by coverage: sub-pixel rays are traced and each face they hit is shaded once, weighted by its
+//     share of the samples. The same pass turns each row's linear radiance into grey levels (sensor model), so
+//     the radiance of the image never goes through memory (only motion blur accumulates it).
 #include "mcslam/sim/renderer.hpp"
 
 #include <algorithm>
@@ -34,12 +35,24 @@ struct Renderer::Impl {
   const CameraLut* lut = nullptr;
   std::vector<uint32_t> key;  // per pixel: surface hit by the centre ray
   std::vector<float> t;       // and its distance
-  std::vector<float> radiance;
+  std::vector<float> radiance;  // sum over the sub-exposures of motion blur
   std::vector<std::vector<Candidate>> tile_cands;
   std::vector<float> samples;  // sub-pixel offsets, (x, y) pairs
+  // Where the last shading pass of a render writes grey levels, and the sensor's per-render parameters.
+  struct Output {
+    Image* image = nullptr;
+    float gain = 1.f;
+    uint32_t stream = 0;  // noise stream of this frame and camera
+    const float* vignette = nullptr;
+  } out;
 
   void visibilityPass(int tile);
-  void shadingPass(int tile, float weight, bool accumulate, bool anti_aliasing);
+  // weight: share of this sub-exposure; accumulate: add to the radiance of the earlier ones; encode: last one,
+  // write grey levels.
+  void shadingPass(int tile, float weight, bool accumulate, bool encode, bool anti_aliasing);
+  void shadeRow(int y, int x0, int x1, bool anti_aliasing, const std::vector<Candidate>& cands, float* values) const;
+  bool uniformQuad(int x, int y, bool anti_aliasing) const;
+  float shadePixel(int x, int y, bool anti_aliasing, const std::vector<Candidate>& cands) const;
   float antiAliased(int x, int y, const std::vector<Candidate>& cands) const;
   bool isEdge(int x, int y) const;
 };
@@ -159,26 +172,76 @@ float Renderer::Impl::antiAliased(int x, int y, const std::vector<Candidate>& ca
   return sum / static_cast<float>(n);
 }
 
-void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool anti_aliasing) {
+// Whether the four pixels from (x, y) (and, with anti-aliasing, their 14 neighbours) all see one surface that
+// shadeQuad handles. A hit implies a valid pixel: rays outside the lens's domain are never traced.
+bool Renderer::Impl::uniformQuad(int x, int y, bool anti_aliasing) const {
+  const int W = lut->width, H = lut->height;
+  const uint32_t* c = &key[static_cast<std::size_t>(y) * W + x];
+  const uint32_t k = c[0];
+  if (k == 0 || ((c[1] ^ k) | (c[2] ^ k) | (c[3] ^ k)) != 0) return false;
+  if (anti_aliasing) {
+    if (x == 0 || y == 0 || x + 4 >= W || y + 1 >= H) return false;
+    const uint32_t *a = c - W, *b = c + W;
+    uint32_t diff = (c[-1] ^ k) | (c[4] ^ k);
+    for (int l = -1; l <= 4; ++l) diff |= (a[l] ^ k) | (b[l] ^ k);
+    if (diff != 0) return false;
+  }
+  return ctx.quadShadable(k);
+}
+
+float Renderer::Impl::shadePixel(int x, int y, bool anti_aliasing, const std::vector<Candidate>& cands) const {
+  const float* r = lut->ray(x, y);
+  if (!(r[3] > 0.f)) return 0.f;
+  if (anti_aliasing && isEdge(x, y)) return antiAliased(x, y, cands);
+  const std::size_t i = static_cast<std::size_t>(y) * lut->width + x;
+  float d[3];
+  ctx.rotate(r, d);
+  return key[i] ? ctx.shade(key[i], t[i], d, r[3]) : ctx.sky(d);
+}
+
+// Radiance of pixels [x0, x1) of row y into values[0, x1 - x0). x0 is a multiple of 4 (tiles are).
+void Renderer::Impl::shadeRow(int y, int x0, int x1, bool anti_aliasing, const std::vector<Candidate>& cands,
+                              float* values) const {
+  const std::size_t row = static_cast<std::size_t>(y) * lut->width;
+  for (int x = x0; x < x1;) {
+    if (x + 4 <= x1 && uniformQuad(x, y, anti_aliasing)) {
+      f4 b[3], angle, t4;
+      for (int l = 0; l < 4; ++l) {
+        const float* r = lut->ray(x + l, y);
+        for (int k = 0; k < 3; ++k) b[k][l] = r[k];
+        angle[l] = r[3];
+        t4[l] = t[row + x + l];
+      }
+      const f4 v = ctx.shadeQuad(key[row + x], t4, b, angle);
+      for (int l = 0; l < 4; ++l) values[x - x0 + l] = v[l];
+      x += 4;
+    } else {
+      values[x - x0] = shadePixel(x, y, anti_aliasing, cands);
+      ++x;
+    }
+  }
+}
+
+void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool encode, bool anti_aliasing) {
   const std::vector<Candidate>& cands = tile_cands[tile];
   const int W = lut->width, H = lut->height, ts = lut->tile;
   const int tx = tile % lut->tiles_x, ty = tile / lut->tiles_x;
-  const int x1 = std::min(W, (tx + 1) * ts), y1 = std::min(H, (ty + 1) * ts);
+  const int x0 = tx * ts, x1 = std::min(W, x0 + ts), y1 = std::min(H, (ty + 1) * ts);
+  float values[64];  // tiles are at most 64 pixels wide
   for (int y = ty * ts; y < y1; ++y) {
-    for (int x = tx * ts; x < x1; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * W + x;
-      const float* r = lut->ray(x, y);
-      float value = 0.f;
-      if (r[3] > 0.f) {
-        if (anti_aliasing && isEdge(x, y)) {
-          value = antiAliased(x, y, cands);
-        } else {
-          float d[3];
-          ctx.rotate(r, d);
-          value = key[i] ? ctx.shade(key[i], t[i], d, r[3]) : ctx.sky(d);
-        }
+    shadeRow(y, x0, x1, anti_aliasing, cands, values);
+    const std::size_t row = static_cast<std::size_t>(y) * W;
+    uint8_t* grey = encode ? out.image->row(y) : nullptr;
+    for (int x = x0; x < x1; ++x) {
+      const std::size_t i = row + x;
+      float v = weight * values[x - x0];
+      if (accumulate) v += radiance[i];
+      if (!encode) {
+        radiance[i] = v;
+        continue;
       }
-      radiance[i] = accumulate ? radiance[i] + weight * value : weight * value;
+      const float vignette = out.vignette[i];
+      grey[x] = vignette > 0.f ? sensor.encode(v * out.gain, vignette, out.stream, static_cast<uint32_t>(i)) : 0;
     }
   }
 }
@@ -230,14 +293,17 @@ void Renderer::render(int cam, const std::function<SE3(double)>& T_w_b_at, doubl
   const std::size_t n = static_cast<std::size_t>(W) * H;
   m.key.resize(n);
   m.t.resize(n);
-  m.radiance.resize(n);
   m.tile_cands.resize(static_cast<std::size_t>(m.lut->tiles_x) * m.lut->tiles_y);
   image.resize(W, H);
   if (depth) depth->resize(W, H);
 
   const double blur = std::max(0.0, options_.sensor.motion_blur_s);
   const int subs = blur > 0 ? options_.sensor.motion_blur_samples : 1;
+  if (subs > 1) m.radiance.resize(n);
   const int tiles = static_cast<int>(m.tile_cands.size());
+  const uint64_t stream = hashOf(options_.seed, frame_key, static_cast<uint64_t>(cam));
+  m.out = {&image, static_cast<float>(exposureGain(cam, time_s)), static_cast<uint32_t>(stream ^ (stream >> 32)),
+           m.vignettes[cam].data()};
   for (int s = 0; s < subs; ++s) {
     const double ts = subs == 1 ? time_s : time_s + blur * ((s + 0.5) / subs - 0.5);
     m.ctx.setup(T_w_b_at(ts) * rig_.T_b_c(cam), ts);
@@ -253,19 +319,8 @@ void Renderer::render(int cam, const std::function<SE3(double)>& T_w_b_at, doubl
     }
     const float weight = 1.f / static_cast<float>(subs);
     const bool aa = options_.anti_aliasing;
-    m.pool.run(tiles, [&m, weight, s, aa](int tile) { m.shadingPass(tile, weight, s > 0, aa); });
+    m.pool.run(tiles, [&m, weight, s, subs, aa](int tile) { m.shadingPass(tile, weight, s > 0, s == subs - 1, aa); });
   }
-
-  const float gain = static_cast<float>(exposureGain(cam, time_s));
-  const uint64_t stream = hashOf(options_.seed, frame_key, static_cast<uint64_t>(cam));
-  const float* vignette = m.vignettes[cam].data();
-  m.pool.run(H, [&](int y) {
-    uint8_t* row = image.row(y);
-    for (int x = 0; x < W; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * W + x;
-      row[x] = vignette[i] > 0.f ? m.sensor.encode(m.radiance[i] * gain, vignette[i], stream, static_cast<uint32_t>(i)) : 0;
-    }
-  });
 }
 
 }  // namespace mcslam::sim

@@ -18,12 +18,13 @@ class SensorModel {
   // Relative gain of camera `cam` at time t (1 without exposure variation).
   double relativeGain(int cam, double t) const;
 
-  // Linear radiance (already multiplied by the gain) -> grey level, for pixel `index` with noise stream `stream`.
-  uint8_t encode(float linear, float vignette, uint64_t stream, uint32_t index) const {
+  // Linear radiance (already multiplied by the gain) -> grey level, for pixel `index` with noise stream `stream`
+  // (one per frame and camera, e.g. from hashOf).
+  uint8_t encode(float linear, float vignette, uint32_t stream, uint32_t index) const {
     float v = linear * vignette;
     if (options_.noise) {
       const float sigma = std::sqrt(std::max(0.f, v) * shot_ + read2_);
-      v += sigma * gauss_[mix64(stream ^ index) & (kGaussSize - 1)];
+      v += sigma * gauss_[hash32(stream ^ index) >> (32 - kGaussBits)];
     }
     if (!(v > 0.f)) return 0;
     if (v >= 1.f) return 255;
@@ -38,7 +39,8 @@ class SensorModel {
   }
 
  private:
-  static constexpr uint32_t kGaussSize = 4096;
+  static constexpr uint32_t kGaussBits = 12;
+  static constexpr uint32_t kGaussSize = 1u << kGaussBits;
   static constexpr uint32_t kGammaSize = 65536;
   SensorOptions options_;
   uint64_t seed_;

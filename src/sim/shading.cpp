@@ -1,0 +1,140 @@
+// Shading of surface hits: texture (mip level from the ray footprint) x baked irradiance + emission. One pixel at a
+// time for any surface, or four neighbouring pixels at once when they all see the same light-mapped box face
+// (most of every image: walls, floors, furniture), where the arithmetic runs on four lanes and the texture level
+// is chosen once for the four.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "frame_context.hpp"
+
+namespace mcslam::sim {
+
+using detail::FaceRecord;
+using detail::Prim;
+
+namespace {
+
+// log2 for mip selection: exponent plus a quadratic in the mantissa (error below 0.01 level).
+inline float fastLog2(float x) {
+  uint32_t bits;
+  std::memcpy(&bits, &x, 4);
+  const float e = static_cast<float>(static_cast<int>((bits >> 23) & 255) - 127);
+  bits = (bits & 0x7fffffu) | 0x3f800000u;
+  float m;
+  std::memcpy(&m, &bits, 4);
+  return e + (-0.34484843f * m + 2.02466578f) * m - 0.67487759f;
+}
+
+// Footprints more elongated than this are filtered along their long axis (blurs grazing floors a little
+// rather than letting them alias).
+constexpr float kMaxAnisotropy = 2.0f;
+
+// Texture filter footprint in texels of a hit at distance t seen under pixel_angle with incidence cosine cos_i.
+// T: float or f4.
+template <class T>
+T footprint(T t, T pixel_angle, T cos_i, const FaceRecord& fr) {
+  const T minor = t * pixel_angle;
+  const T major = minor / vmax(cos_i, 0.02f);
+  return vmax(minor, major * (1.f / kMaxAnisotropy)) * std::max(fr.su, fr.sv);
+}
+
+inline float lodOf(float footprint) { return footprint > 1.f ? fastLog2(footprint) : 0.f; }
+
+// Face coordinates of a box hit: texture (tx, ty), light-map cell (lx, ly), and the cosine of incidence.
+template <class T>
+struct FaceCoords {
+  T tx, ty, lx, ly, cos_i;
+};
+
+template <class T>
+FaceCoords<T> boxFaceCoords(const FaceRecord& fr, const float o[3], T t, const T dl[3]) {
+  const T qa = o[fr.axis_u] + t * dl[fr.axis_u], qb = o[fr.axis_v] + t * dl[fr.axis_v];
+  return {qa * fr.tex_u[0] + fr.tex_u[1], qb * fr.tex_v[0] + fr.tex_v[1], qa * fr.lm_u[0] + fr.lm_u[1],
+          qb * fr.lm_v[0] + fr.lm_v[1], vabs(dl[fr.axis_n])};
+}
+
+// Bilinear irradiance of light-map cell coordinates (x, y).
+float lightmapIrradiance(const detail::WorldData& w, const detail::LightmapRecord& lm, float lx, float ly) {
+  const float x = std::clamp(lx, 0.f, static_cast<float>(lm.w - 1));
+  const float y = std::clamp(ly, 0.f, static_cast<float>(lm.h - 1));
+  const int x0 = std::min(static_cast<int>(x), lm.w - 2), y0 = std::min(static_cast<int>(y), lm.h - 2);
+  const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+  const float* c = &w.lightmap_values[lm.offset + static_cast<std::size_t>(y0) * lm.w + x0];
+  const float a = c[0] + fx * (c[1] - c[0]);
+  const float b = c[lm.w] + fx * (c[lm.w + 1] - c[lm.w]);
+  return a + fy * (b - a);
+}
+
+}  // namespace
+
+float FrameContext::shade(uint32_t k, float t_hit, const float d[3], float pixel_angle) const {
+  const int pi = keyPrim(k), face = keyFace(k);
+  const Prim& p = prim(pi);
+  const FaceRecord& fr = world_.faces[p.face0 + face];
+  const float* o = localOrigin(pi);
+  float dl[3];
+  p.toLocal(d, dl);
+  FaceCoords<float> c;
+  if (p.type == detail::PrimType::Box) {
+    c = boxFaceCoords(fr, o, t_hit, dl);
+  } else {
+    float q[3], n[3], u, v;
+    for (int i = 0; i < 3; ++i) q[i] = o[i] + t_hit * dl[i];
+    detail::faceUv(p, face, q, u, v);
+    detail::faceNormal(p, face, q, n);
+    c.tx = u * fr.su + fr.ou;
+    c.ty = fr.ov - v * fr.sv;
+    c.cos_i = std::abs(n[0] * dl[0] + n[1] * dl[1] + n[2] * dl[2]);
+    c.lx = c.ly = 0.f;
+    if (fr.lightmap >= 0) {
+      const detail::LightmapRecord& lm = world_.lightmaps[fr.lightmap];
+      c.lx = u * lm.su - 0.5f;
+      c.ly = v * lm.sv - 0.5f;
+    }
+  }
+
+  float albedo = fr.albedo;
+  if (fr.texture >= 0) {
+    const float lod = lodOf(footprint(t_hit, pixel_angle, c.cos_i, fr));
+    albedo *= to_linear_[static_cast<int>(world_.textures[fr.texture].sample(c.tx, c.ty, lod) * 4.f)];
+  }
+  float irradiance;
+  if (fr.lightmap >= 0) {
+    irradiance = lightmapIrradiance(world_, world_.lightmaps[fr.lightmap], c.lx, c.ly);
+  } else {
+    float q[3], n[3], nw[3];
+    for (int i = 0; i < 3; ++i) q[i] = o[i] + t_hit * dl[i];
+    detail::faceNormal(p, face, q, n);
+    p.toWorld(n, nw);
+    irradiance = world_.unlitIrradiance(Vec3(nw[0], nw[1], nw[2]));
+  }
+  return albedo * irradiance + fr.emission;
+}
+
+bool FrameContext::quadShadable(uint32_t k) const {
+  const Prim& p = prim(keyPrim(k));
+  return p.type == detail::PrimType::Box && world_.faces[p.face0 + keyFace(k)].lightmap >= 0;
+}
+
+f4 FrameContext::shadeQuad(uint32_t k, f4 t_hit, const f4 b[3], f4 pixel_angle) const {
+  const int pi = keyPrim(k);
+  const Prim& p = prim(pi);
+  const FaceRecord& fr = world_.faces[p.face0 + keyFace(k)];
+  f4 d[3], dl[3];
+  rotate(b, d);
+  p.toLocal(d, dl);
+  const FaceCoords<f4> c = boxFaceCoords(fr, localOrigin(pi), t_hit, dl);
+  f4 albedo = splat(fr.albedo);
+  if (fr.texture >= 0) {
+    const float lod = lodOf(0.25f * sum(footprint(t_hit, pixel_angle, c.cos_i, fr)));
+    const i4 grey = toInt(world_.textures[fr.texture].sample4(c.tx, c.ty, lod) * 4.f);
+    for (int l = 0; l < 4; ++l) albedo[l] *= to_linear_[grey[l]];
+  }
+  const detail::LightmapRecord& lm = world_.lightmaps[fr.lightmap];
+  f4 irradiance;
+  for (int l = 0; l < 4; ++l) irradiance[l] = lightmapIrradiance(world_, lm, c.lx[l], c.ly[l]);
+  return albedo * irradiance + fr.emission;
+}
+
+}  // namespace mcslam::sim
