@@ -14,8 +14,9 @@ inline uint64_t mix64(uint64_t x) {  // splitmix64 finaliser
 }
 
 // 32-bit finaliser (Wellons' "lowbias32"): for the per-pixel sensor noise, where mix64's two 64-bit products
-// were a visible share of the render time.
-inline uint32_t hash32(uint32_t x) {
+// were a visible share of the render time. U: uint32_t, or a vector of them (lanes hashed independently).
+template <class U>
+inline U hash32(U x) {
   x ^= x >> 16;
   x *= 0x7feb352dU;
   x ^= x >> 15;

@@ -232,16 +232,22 @@ void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool e
     shadeRow(y, x0, x1, anti_aliasing, cands, values);
     const std::size_t row = static_cast<std::size_t>(y) * W;
     uint8_t* grey = encode ? out.image->row(y) : nullptr;
-    for (int x = x0; x < x1; ++x) {
+    for (int x = x0; x < x1; x += 4) {
+      const int n = std::min(4, x1 - x);  // 4 but at the right edge of an image whose width is no multiple of 4
       const std::size_t i = row + x;
-      float v = weight * values[x - x0];
-      if (accumulate) v += radiance[i];
+      f4 v = {}, vignette = {};
+      for (int l = 0; l < n; ++l) {
+        v[l] = weight * values[x - x0 + l];
+        if (accumulate) v[l] += radiance[i + l];
+        vignette[l] = out.vignette[i + l];
+      }
       if (!encode) {
-        radiance[i] = v;
+        for (int l = 0; l < n; ++l) radiance[i + l] = v[l];
         continue;
       }
-      const float vignette = out.vignette[i];
-      grey[x] = vignette > 0.f ? sensor.encode(v * out.gain, vignette, out.stream, static_cast<uint32_t>(i)) : 0;
+      uint8_t q[4];
+      sensor.encode4(v * out.gain, vignette, out.stream, static_cast<uint32_t>(i), q);
+      for (int l = 0; l < n; ++l) grey[x + l] = q[l];
     }
   }
 }

@@ -8,10 +8,12 @@ namespace mcslam::sim {
 
 typedef float f4 __attribute__((vector_size(16)));
 typedef int32_t i4 __attribute__((vector_size(16)));
+typedef uint32_t u4 __attribute__((vector_size(16)));
 
 inline f4 splat(float v) { return f4{v, v, v, v}; }
 inline f4 vmin(f4 a, f4 b) { return a < b ? a : b; }
 inline f4 vmax(f4 a, f4 b) { return a > b ? a : b; }
+inline f4 vmin(f4 a, float b) { return vmin(a, splat(b)); }
 inline f4 vabs(f4 a) { return a < 0.f ? -a : a; }
 inline f4 toFloat(i4 a) { return __builtin_convertvector(a, f4); }
 // Truncation towards zero (cvttps2dq).
