@@ -68,6 +68,15 @@ int Initializer::matchToReference(const FrameFeatures& f) {
   return static_cast<int>(correspondences_.size());
 }
 
+RelativePoseOptions Initializer::relativePoseOptions(uint64_t frame_index) const {
+  RelativePoseOptions ro;
+  ro.seed = 1 + frame_index;
+  const double f_mean = 0.5 * (rig_.model(0).fx() + rig_.model(0).fy());
+  ro.bearing_sigma_rad = 0.7 / f_mean;  // keypoints at the finest octave: ~0.7 px; inliers within 3 sigma
+  ro.min_inliers = std::max(20, options_.init_min_matches / 2);
+  return ro;
+}
+
 Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_index, SE3& T_ref_cur) {
   if (!has_reference_) {
     reference_ = f;
@@ -87,11 +96,7 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
     last_status_ = RelativePoseStatus::TooFewCorrespondences;
     return TwoFrame::Waiting;
   }
-  RelativePoseOptions ro;
-  ro.seed = 1 + frame_index;
-  const double f_mean = 0.5 * (rig_.model(0).fx() + rig_.model(0).fy());
-  ro.bearing_sigma_rad = 0.7 / f_mean;  // keypoints at the finest octave: ~0.7 px; inliers within 3 sigma
-  ro.min_inliers = std::max(20, options_.init_min_matches / 2);
+  const RelativePoseOptions ro = relativePoseOptions(frame_index);
   RelativePoseResult r;
   if (rig_.size() == 1) {
     r = estimateCentralRelativePose(correspondences_, ro);
