@@ -76,15 +76,10 @@ class MipTexture {
     texelCoords(L, u, v, x0, y0, x1, y1, fx, fy);
     const i4 r0 = y0 << L.shift, r1 = y1 << L.shift;
     const uint8_t* base = data_.get() + L.offset;
-    i4 t00, t10, t01, t11;
-    for (int l = 0; l < 4; ++l) {
-      t00[l] = base[r0[l] + x0[l]];
-      t10[l] = base[r0[l] + x1[l]];
-      t01[l] = base[r1[l] + x0[l]];
-      t11[l] = base[r1[l] + x1[l]];
-    }
-    const f4 a = toFloat(t00) + fx * (toFloat(t10) - toFloat(t00));
-    const f4 b = toFloat(t01) + fx * (toFloat(t11) - toFloat(t01));
+    const f4 t00 = gatherBytes(base, r0 + x0), t10 = gatherBytes(base, r0 + x1);
+    const f4 t01 = gatherBytes(base, r1 + x0), t11 = gatherBytes(base, r1 + x1);
+    const f4 a = t00 + fx * (t10 - t00);
+    const f4 b = t01 + fx * (t11 - t01);
     return a + fy * (b - a);
   }
   __attribute__((always_inline)) float bilinear(const Level& L, float u, float v) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace mcslam::sim {
 
@@ -62,12 +63,9 @@ void tracePacket(const FrameContext& ctx, const std::vector<Candidate>& cands, c
   }
 
   hint = -1;
-  for (int l = 0; l < 4; ++l) {
-    const bool hit = best_c[l] >= 0;
-    keys[l] = static_cast<uint32_t>(best_key[l]);
-    t[l] = hit ? best[l] : 0.f;
-    if (hint < 0) hint = best_c[l];
-  }
+  for (int l = 0; l < 4 && hint < 0; ++l) hint = best_c[l];
+  std::memcpy(keys, &best_key, sizeof best_key);
+  store4(t, best_c >= 0 ? best : splat(0.f));
 }
 
 }  // namespace mcslam::sim

@@ -37,7 +37,9 @@ struct Renderer::Impl {
   std::vector<float> t;       // and its distance
   std::vector<float> radiance;  // sum over the sub-exposures of motion blur
   std::vector<std::vector<Candidate>> tile_cands;
-  std::vector<float> samples;  // sub-pixel offsets, (x, y) pairs
+  // Sub-pixel offsets of the anti-aliasing samples, padded to whole packets of four with copies of the last.
+  int n_samples = 0;
+  std::vector<float> sample_x, sample_y;
   // Where the last shading pass of a render writes grey levels, and the sensor's per-render parameters.
   struct Output {
     Image* image = nullptr;
@@ -47,6 +49,8 @@ struct Renderer::Impl {
   } out;
 
   void visibilityPass(int tile);
+  // Rays of pixels x..x+n-1 (n <= 4) of row y as columns: bearing x, y, z and pixel angle (0 in lanes >= n).
+  void quadRays(int x, int y, int n, f4 b[4]) const;
   // weight: share of this sub-exposure; accumulate: add to the radiance of the earlier ones; encode: last one,
   // write grey levels.
   void shadingPass(int tile, float weight, bool accumulate, bool encode, bool anti_aliasing);
@@ -63,31 +67,35 @@ void Renderer::Impl::visibilityPass(int tile) {
   const int W = lut->width, H = lut->height, ts = lut->tile;
   const int tx = tile % lut->tiles_x, ty = tile / lut->tiles_x;
   const int x0 = tx * ts, x1 = std::min(W, x0 + ts), y1 = std::min(H, (ty + 1) * ts);
-  const float* R = ctx.rotation();
   int hint = -1;
   for (int y = ty * ts; y < y1; ++y) {
     for (int x = x0; x < x1; x += 4) {
-      // Gather up to four bearings and turn them into world directions.
-      f4 b[3] = {}, size = {};
+      // Four bearings (x, y, z, pixel angle; angle 0 for invalid pixels and past the image's right edge) turned
+      // into world directions.
+      const int n = std::min(4, x1 - x);
+      f4 b[4];
+      quadRays(x, y, n, b);
       RayPacket rays;
-      for (int l = 0; l < 4; ++l) {
-        const float* r = lut->ray(std::min(x + l, W - 1), y);
-        const bool real = x + l < x1 && r[3] > 0.f;
-        for (int k = 0; k < 3; ++k) b[k][l] = r[k];
-        size[l] = real ? 1.f : 0.f;
-      }
-      for (int k = 0; k < 3; ++k) rays.d[k] = R[3 * k] * b[0] + R[3 * k + 1] * b[1] + R[3 * k + 2] * b[2];
-      rays.active = size > 0.f;
-      uint32_t keys[4];
-      float ts4[4];
-      tracePacket(ctx, cands, rays, hint, keys, ts4);
-      for (int l = 0; l < 4 && x + l < x1; ++l) {
-        const std::size_t i = static_cast<std::size_t>(y) * W + x + l;
-        key[i] = keys[l];
-        t[i] = ts4[l];
+      ctx.rotate(b, rays.d);
+      rays.active = b[3] > 0.f;
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      if (n == 4) {
+        tracePacket(ctx, cands, rays, hint, &key[i], &t[i]);
+      } else {
+        uint32_t keys[4];
+        float ts4[4];
+        tracePacket(ctx, cands, rays, hint, keys, ts4);
+        std::copy_n(keys, n, &key[i]);
+        std::copy_n(ts4, n, &t[i]);
       }
     }
   }
+}
+
+void Renderer::Impl::quadRays(int x, int y, int n, f4 b[4]) const {
+  f4 r[4];
+  for (int l = 0; l < 4; ++l) r[l] = l < n ? load4(lut->ray(x + l, y)) : splat(0.f);
+  transpose4(r, b);
 }
 
 bool Renderer::Impl::isEdge(int x, int y) const {
@@ -128,22 +136,19 @@ float Renderer::Impl::antiAliased(int x, int y, const std::vector<Candidate>& ca
     gx[c] = okx ? (rb[c] - ra[c]) / static_cast<float>(xb - xa) : 0.f;
     gy[c] = oky ? (rd[c] - rc[c]) / static_cast<float>(yb - ya) : 0.f;
   }
-  const int n = static_cast<int>(samples.size() / 2);
-  const float* R = ctx.rotation();
+  const int n = n_samples;
   uint32_t keys[64];
   float dist[64], dirs[64][3];
   int hint = -1;
   for (int s0 = 0; s0 < n; s0 += 4) {
-    RayPacket rays;
+    const f4 sx = load4(&sample_x[s0]), sy = load4(&sample_y[s0]);
     f4 b[3];
-    for (int l = 0; l < 4; ++l) {
-      const int s = std::min(s0 + l, n - 1);
-      const float sx = samples[2 * s], sy = samples[2 * s + 1];
-      float v[3] = {r[0] + sx * gx[0] + sy * gy[0], r[1] + sx * gx[1] + sy * gy[1], r[2] + sx * gx[2] + sy * gy[2]};
-      const float inv = 1.f / std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      for (int k = 0; k < 3; ++k) b[k][l] = v[k] * inv;
-    }
-    for (int k = 0; k < 3; ++k) rays.d[k] = R[3 * k] * b[0] + R[3 * k + 1] * b[1] + R[3 * k + 2] * b[2];
+    for (int k = 0; k < 3; ++k) b[k] = r[k] + sx * gx[k] + sy * gy[k];
+    const f4 len2 = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    const f4 inv = lanes([&](int l) { return 1.f / std::sqrt(len2[l]); });
+    for (int k = 0; k < 3; ++k) b[k] *= inv;
+    RayPacket rays;
+    ctx.rotate(b, rays.d);
     rays.active = i4{-1, -1, -1, -1};
     uint32_t k4[4];
     float t4[4];
@@ -205,15 +210,9 @@ void Renderer::Impl::shadeRow(int y, int x0, int x1, bool anti_aliasing, const s
   const std::size_t row = static_cast<std::size_t>(y) * lut->width;
   for (int x = x0; x < x1;) {
     if (x + 4 <= x1 && uniformQuad(x, y, anti_aliasing)) {
-      f4 b[3], angle, t4;
-      for (int l = 0; l < 4; ++l) {
-        const float* r = lut->ray(x + l, y);
-        for (int k = 0; k < 3; ++k) b[k][l] = r[k];
-        angle[l] = r[3];
-        t4[l] = t[row + x + l];
-      }
-      const f4 v = ctx.shadeQuad(key[row + x], t4, b, angle);
-      for (int l = 0; l < 4; ++l) values[x - x0 + l] = v[l];
+      f4 b[4];
+      quadRays(x, y, 4, b);
+      store4(values + (x - x0), ctx.shadeQuad(key[row + x], load4(&t[row + x]), b, b[3]));
       x += 4;
     } else {
       values[x - x0] = shadePixel(x, y, anti_aliasing, cands);
@@ -235,19 +234,16 @@ void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool e
     for (int x = x0; x < x1; x += 4) {
       const int n = std::min(4, x1 - x);  // 4 but at the right edge of an image whose width is no multiple of 4
       const std::size_t i = row + x;
-      f4 v = {}, vignette = {};
-      for (int l = 0; l < n; ++l) {
-        v[l] = weight * values[x - x0 + l];
-        if (accumulate) v[l] += radiance[i + l];
-        vignette[l] = out.vignette[i + l];
-      }
+      f4 v = weight * load4(values + (x - x0), n);
+      if (accumulate) v += load4(&radiance[i], n);
       if (!encode) {
-        for (int l = 0; l < n; ++l) radiance[i + l] = v[l];
+        store4(&radiance[i], v, n);
         continue;
       }
       uint8_t q[4];
-      sensor.encode4(v * out.gain, vignette, out.stream, static_cast<uint32_t>(i), q);
-      for (int l = 0; l < n; ++l) grey[x + l] = q[l];
+      const uint32_t index = static_cast<uint32_t>(i);
+      sensor.encode4(v * out.gain, load4(out.vignette + i, n), out.stream, index, n == 4 ? grey + x : q);
+      if (n < 4) std::copy_n(q, n, grey + x);
     }
   }
 }
@@ -274,9 +270,11 @@ Renderer::Renderer(std::shared_ptr<const World> world, Rig rig, RenderOptions op
   const int n = options_.edge_samples;
   int stride = n > 2 ? 3 : 1;
   while (n > 2 && std::gcd(stride, n) != 1) ++stride;
-  for (int s = 0; s < n; ++s) {
-    impl_->samples.push_back((static_cast<float>(s) + 0.5f) / static_cast<float>(n) - 0.5f);
-    impl_->samples.push_back((static_cast<float>((s * stride) % n) + 0.5f) / static_cast<float>(n) - 0.5f);
+  impl_->n_samples = n;
+  for (int s = 0; s < (n + 3) / 4 * 4; ++s) {
+    const int q = std::min(s, n - 1);
+    impl_->sample_x.push_back((static_cast<float>(q) + 0.5f) / static_cast<float>(n) - 0.5f);
+    impl_->sample_y.push_back((static_cast<float>((q * stride) % n) + 0.5f) / static_cast<float>(n) - 0.5f);
   }
 }
 

@@ -25,10 +25,9 @@ class SensorModel {
   void encode4(f4 linear, f4 vignette, uint32_t stream, uint32_t index, uint8_t out[4]) const {
     f4 v = linear * vignette;
     if (options_.noise) {
-      f4 sigma2 = vmax(v, 0.f) * shot_ + read2_, noise;
+      const f4 sigma2 = vmax(v, 0.f) * shot_ + read2_;
       const u4 h = hash32(u4{index, index + 1, index + 2, index + 3} ^ stream) >> (32 - kGaussBits);
-      for (int l = 0; l < 4; ++l) noise[l] = std::sqrt(sigma2[l]) * gauss_[h[l]];
-      v += noise;
+      v += lanes([&](int l) { return std::sqrt(sigma2[l]) * gauss_[h[l]]; });
     }
     v = vignette > 0.f ? vmin(vmax(v, 0.f), 1.f) : splat(0.f);  // NaN -> 0 too
     const i4 level = toInt(v * static_cast<float>(kGammaSize - 1) + 0.5f);

@@ -129,11 +129,10 @@ f4 FrameContext::shadeQuad(uint32_t k, f4 t_hit, const f4 b[3], f4 pixel_angle) 
   if (fr.texture >= 0) {
     const float lod = lodOf(0.25f * sum(footprint(t_hit, pixel_angle, c.cos_i, fr)));
     const i4 grey = toInt(world_.textures[fr.texture].sample4(c.tx, c.ty, lod) * 4.f);
-    for (int l = 0; l < 4; ++l) albedo[l] *= to_linear_[grey[l]];
+    albedo *= lanes([&](int l) { return to_linear_[grey[l]]; });
   }
   const detail::LightmapRecord& lm = world_.lightmaps[fr.lightmap];
-  f4 irradiance;
-  for (int l = 0; l < 4; ++l) irradiance[l] = lightmapIrradiance(world_, lm, c.lx[l], c.ly[l]);
+  const f4 irradiance = lanes([&](int l) { return lightmapIrradiance(world_, lm, c.lx[l], c.ly[l]); });
   return albedo * irradiance + fr.emission;
 }
 

@@ -3,6 +3,7 @@
 // so the build stays portable). The renderer works on four neighbouring pixels at a time: their rays share the
 // camera centre, the tile's candidates and, most of the time, the surface they hit.
 #include <cstdint>
+#include <cstring>
 
 namespace mcslam::sim {
 
@@ -39,6 +40,46 @@ inline int floorInt(float v) {
   return v < static_cast<float>(i) ? i - 1 : i;
 }
 inline int clampBelow(int v, int n) { return v < 0 ? 0 : (v >= n ? n - 1 : v); }
+// Vectors are built and taken apart in registers: setting lanes one by one goes through the stack, and reading
+// the 16 bytes back then stalls on store forwarding (which showed in the profile).
+// {f(0), f(1), f(2), f(3)}
+template <class F>
+inline f4 lanes(F f) {
+  return f4{f(0), f(1), f(2), f(3)};
+}
+inline f4 load4(const float* p) {
+  f4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store4(float* p, f4 v) { std::memcpy(p, &v, sizeof v); }
+// The first n (<= 4) floats only (at the right edge of an image whose width is no multiple of 4); other lanes 0.
+inline f4 load4(const float* p, int n) {
+  if (n == 4) return load4(p);
+  float pad[4] = {};
+  std::memcpy(pad, p, sizeof(float) * n);
+  return load4(pad);
+}
+inline void store4(float* p, f4 v, int n) {
+  float pad[4];
+  store4(pad, v);
+  std::memcpy(p, pad, sizeof(float) * n);
+}
+// Bytes base[idx[0]], ..., base[idx[3]] as floats.
+inline f4 gatherBytes(const uint8_t* base, i4 idx) {
+  return toFloat(i4{base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]]});
+}
+// Four rows (x, y, z, w) -> four columns: xs, ys, zs, ws.
+inline void transpose4(const f4 r[4], f4 c[4]) {
+  const i4 lo = {0, 4, 1, 5}, hi = {2, 6, 3, 7}, first = {0, 1, 4, 5}, second = {2, 3, 6, 7};
+  const f4 xy01 = __builtin_shuffle(r[0], r[1], lo), xy23 = __builtin_shuffle(r[2], r[3], lo);
+  const f4 zw01 = __builtin_shuffle(r[0], r[1], hi), zw23 = __builtin_shuffle(r[2], r[3], hi);
+  c[0] = __builtin_shuffle(xy01, xy23, first);
+  c[1] = __builtin_shuffle(xy01, xy23, second);
+  c[2] = __builtin_shuffle(zw01, zw23, first);
+  c[3] = __builtin_shuffle(zw01, zw23, second);
+}
+
 inline float sum(f4 a) { return (a[0] + a[1]) + (a[2] + a[3]); }
 
 }  // namespace mcslam::sim
