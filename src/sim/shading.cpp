@@ -54,15 +54,18 @@ FaceCoords<T> boxFaceCoords(const FaceRecord& fr, const float o[3], T t, const T
           qb * fr.lm_v[0] + fr.lm_v[1], vabs(dl[fr.axis_n])};
 }
 
-// Bilinear irradiance of light-map cell coordinates (x, y).
-float lightmapIrradiance(const detail::WorldData& w, const detail::LightmapRecord& lm, float lx, float ly) {
-  const float x = std::clamp(lx, 0.f, static_cast<float>(lm.w - 1));
-  const float y = std::clamp(ly, 0.f, static_cast<float>(lm.h - 1));
-  const int x0 = std::min(static_cast<int>(x), lm.w - 2), y0 = std::min(static_cast<int>(y), lm.h - 2);
-  const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
-  const float* c = &w.lightmap_values[lm.offset + static_cast<std::size_t>(y0) * lm.w + x0];
-  const float a = c[0] + fx * (c[1] - c[0]);
-  const float b = c[lm.w] + fx * (c[lm.w + 1] - c[lm.w]);
+// Bilinear irradiance at light-map cell coordinates (lx, ly). F: float, or f4 for four points of one face.
+template <class F>
+F lightmapIrradiance(const detail::WorldData& w, const detail::LightmapRecord& lm, F lx, F ly) {
+  const F x = vmin(vmax(lx, 0.f), static_cast<float>(lm.w - 1));
+  const F y = vmin(vmax(ly, 0.f), static_cast<float>(lm.h - 1));
+  const auto x0 = vmin(toInt(x), lm.w - 2), y0 = vmin(toInt(y), lm.h - 2);
+  const F fx = x - toFloat(x0), fy = y - toFloat(y0);
+  const float* c = &w.lightmap_values[lm.offset];
+  const auto i = y0 * lm.w + x0;
+  const F c00 = gather(c, i), c10 = gather(c, i + 1), c01 = gather(c, i + lm.w), c11 = gather(c, i + lm.w + 1);
+  const F a = c00 + fx * (c10 - c00);
+  const F b = c01 + fx * (c11 - c01);
   return a + fy * (b - a);
 }
 
@@ -131,9 +134,7 @@ f4 FrameContext::shadeQuad(uint32_t k, f4 t_hit, const f4 b[3], f4 pixel_angle) 
     const i4 grey = toInt(world_.textures[fr.texture].sample4(c.tx, c.ty, lod) * 4.f);
     albedo *= lanes([&](int l) { return to_linear_[grey[l]]; });
   }
-  const detail::LightmapRecord& lm = world_.lightmaps[fr.lightmap];
-  const f4 irradiance = lanes([&](int l) { return lightmapIrradiance(world_, lm, c.lx[l], c.ly[l]); });
-  return albedo * irradiance + fr.emission;
+  return albedo * lightmapIrradiance(world_, world_.lightmaps[fr.lightmap], c.lx, c.ly) + fr.emission;
 }
 
 }  // namespace mcslam::sim

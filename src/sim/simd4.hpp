@@ -15,6 +15,10 @@ inline f4 splat(float v) { return f4{v, v, v, v}; }
 inline f4 vmin(f4 a, f4 b) { return a < b ? a : b; }
 inline f4 vmax(f4 a, f4 b) { return a > b ? a : b; }
 inline f4 vmin(f4 a, float b) { return vmin(a, splat(b)); }
+inline i4 vmin(i4 a, int b) {
+  const i4 v = {b, b, b, b};
+  return a < v ? a : v;
+}
 inline f4 vabs(f4 a) { return a < 0.f ? -a : a; }
 inline f4 toFloat(i4 a) { return __builtin_convertvector(a, f4); }
 // Truncation towards zero (cvttps2dq).
@@ -33,6 +37,10 @@ inline i4 clampBelow(i4 v, int n) {
 inline f4 vmax(f4 a, float b) { return vmax(a, splat(b)); }
 // Scalar twins, so that code templated on the lane type reads the same for one pixel and for four.
 inline float vmax(float a, float b) { return a > b ? a : b; }
+inline float vmin(float a, float b) { return a < b ? a : b; }
+inline int vmin(int a, int b) { return a < b ? a : b; }
+inline int toInt(float a) { return static_cast<int>(a); }
+inline float gather(const float* base, int idx) { return base[idx]; }
 inline float vabs(float a) { return a < 0.f ? -a : a; }
 inline float toFloat(int a) { return static_cast<float>(a); }
 inline int floorInt(float v) {
@@ -65,6 +73,7 @@ inline void store4(float* p, f4 v, int n) {
   store4(pad, v);
   std::memcpy(p, pad, sizeof(float) * n);
 }
+inline f4 gather(const float* base, i4 idx) { return f4{base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]]}; }
 // Bytes base[idx[0]], ..., base[idx[3]] as floats.
 inline f4 gatherBytes(const uint8_t* base, i4 idx) {
   return toFloat(i4{base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]]});
