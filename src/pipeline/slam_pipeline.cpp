@@ -31,16 +31,25 @@ SlamPipeline::SlamPipeline(const Rig& rig, const PipelineConfig& config)
       odometry_(rig_, effectiveOdometryOptions(config_, front_end_.overlap()), config_.orb.max_features),
       features_(rig_.size(), config_.orb.max_features) {}
 
+void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing) {
+  front_end_.compute(frame, out);
+  const FrontEndTiming& f = front_end_.timing();
+  timing.features_ms = f.extraction_ms + f.multiview_ms;
+}
+
+void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out,
+                         PipelineTiming& timing) {
+  odometry_.process(features, sequence, out);
+  out.t = t;
+  const OdometryTiming& o = odometry_.timing();
+  timing.tracking_ms = o.tracking_ms + o.mapping_ms;
+  timing.optimization_ms = o.backend_ms;
+}
+
 void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {
   const auto start = std::chrono::steady_clock::now();
-  front_end_.compute(frame, features_);
-  odometry_.process(features_, frame.sequence, out);
-  out.t = frame.t;
-  const FrontEndTiming& f = front_end_.timing();
-  const OdometryTiming& o = odometry_.timing();
-  timing_.features_ms = f.extraction_ms + f.multiview_ms;
-  timing_.tracking_ms = o.tracking_ms + o.mapping_ms;
-  timing_.optimization_ms = o.backend_ms;
+  computeFeatures(frame, features_, timing_);
+  track(features_, frame.sequence, frame.t, out, timing_);
   timing_.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 

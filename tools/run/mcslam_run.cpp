@@ -34,14 +34,36 @@ YAML::Node slamSection(const std::string& path) {
 struct LoadedFrame {
   std::vector<Image> images;
   std::vector<bool> present;
-  std::string error;
 };
 
-LoadedFrame loadFrame(const Dataset& ds, std::size_t i) {
+// Frame i through the front-end: images decoded, features computed into `out`.
+struct PreparedFrame {
+  PipelineTiming timing;  // features_ms
+  double wall_ms = 0;     // decoding and front-end
+  std::string error;      // an unreadable image (its camera is then absent)
+};
+
+PreparedFrame prepareFrame(const Dataset& ds, SlamPipeline& pipeline, std::size_t i, FrameFeatures& out) {
+  const auto start = std::chrono::steady_clock::now();
+  PreparedFrame p;
   LoadedFrame f;
   f.images.resize(ds.rig().size());
-  ds.loadImages(i, f.images, f.present, &f.error);
-  return f;
+  ds.loadImages(i, f.images, f.present, &p.error);
+  std::vector<ImageView> views(ds.rig().size());
+  std::unique_ptr<bool[]> present(new bool[ds.rig().size()]);
+  for (int c = 0; c < ds.rig().size(); ++c) {
+    present[c] = f.present[c];
+    views[c] = f.present[c] ? f.images[c].view() : ImageView{};
+  }
+  RigFrameView view;
+  view.t = ds.frames()[i].t;
+  view.sequence = i;
+  view.cameras = ds.rig().size();
+  view.images = views.data();
+  view.present = present.get();
+  pipeline.computeFeatures(view, out, p.timing);
+  p.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return p;
 }
 
 void progress(std::size_t done, std::size_t total, double ms_per_frame, const PoseEstimate& pose) {
@@ -57,7 +79,7 @@ void progress(std::size_t done, std::size_t total, double ms_per_frame, const Po
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
   std::string dataset_dir, calibration_path, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
-  bool quiet = false, print_config = false;
+  bool quiet = false, print_config = false, sequential = false;
   std::size_t max_frames = 0;
   app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
       ->required();
@@ -71,6 +93,9 @@ int main(int argc, char** argv) {
   app.add_option("--extrinsics", extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", quiet, "No progress bar");
+  app.add_flag("--sequential", sequential,
+               "Run the front-end of the next frame only after the odometry of this one (same output, slower; "
+               "by default they overlap on two threads)");
   app.add_flag("--print-config", print_config,
                "Print the effective `slam:` configuration (defaults, --config, this dataset's rig) and exit");
   CLI11_PARSE(app, argc, argv);
@@ -89,6 +114,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     SlamPipeline pipeline(ds.rig(), config);
+    const bool overlap = !sequential;
     const std::size_t frames = max_frames > 0 ? std::min(max_frames, ds.size()) : ds.size();
     run::RunReport report;
     const bool show = !quiet && ::isatty(STDERR_FILENO);
@@ -97,30 +123,29 @@ int main(int argc, char** argv) {
                    ds.rig().size(), ds.rig().size() == 1 ? "" : "s", frames);
     }
 
+    // The front-end of frame i+1 (image decoding, ORB, multi-view features) runs on its own thread while the
+    // odometry works on frame i: the two stages share no state, so the output is the same as one after the other
+    // (--sequential), only sooner.
+    FrameFeatures buffers[2] = {pipeline.makeFrameFeatures(), pipeline.makeFrameFeatures()};
+    auto launch = [&](std::size_t i) {
+      return std::async(std::launch::async, [&ds, &pipeline, &buffers, i] { return prepareFrame(ds, pipeline, i, buffers[i % 2]); });
+    };
     const auto wall_start = std::chrono::steady_clock::now();
-    std::future<LoadedFrame> next = std::async(std::launch::async, loadFrame, std::cref(ds), std::size_t{0});
-    std::vector<ImageView> views(ds.rig().size());
-    std::unique_ptr<bool[]> present(new bool[ds.rig().size()]);
+    std::future<PreparedFrame> pending = launch(0);
     bool was_initialized = false;
     double ms_avg = 0;
     for (std::size_t i = 0; i < frames; ++i) {
-      LoadedFrame frame = next.get();
-      if (i + 1 < frames) next = std::async(std::launch::async, loadFrame, std::cref(ds), i + 1);  // decode ahead
-      if (!frame.error.empty()) std::fprintf(stderr, "%smcslam-run: frame %zu: %s\n", show ? "\n" : "", i, frame.error.c_str());
-      for (int c = 0; c < ds.rig().size(); ++c) {
-        present[c] = frame.present[c];
-        views[c] = frame.present[c] ? frame.images[c].view() : ImageView{};
-      }
-      RigFrameView view;
-      view.t = ds.frames()[i].t;
-      view.sequence = i;
-      view.cameras = ds.rig().size();
-      view.images = views.data();
-      view.present = present.get();
+      PreparedFrame prepared = pending.get();
+      if (overlap && i + 1 < frames) pending = launch(i + 1);
+      if (!prepared.error.empty()) std::fprintf(stderr, "%smcslam-run: frame %zu: %s\n", show ? "\n" : "", i, prepared.error.c_str());
       PoseEstimate pose;
-      pipeline.process(view, pose);
+      PipelineTiming timing = prepared.timing;
+      const auto track_start = std::chrono::steady_clock::now();
+      pipeline.track(buffers[i % 2], i, ds.frames()[i].t, pose, timing);
+      timing.total_ms = prepared.wall_ms + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - track_start).count();
+      if (!overlap && i + 1 < frames) pending = launch(i + 1);
       // Losing and regaining track are worth a line of their own (the stats file lists them all).
-      if (report.add(pose, pipeline.timing()) && !quiet && i > 0) {
+      if (report.add(pose, timing) && !quiet && i > 0) {
         std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s\n", show ? "\r\033[K" : "", i, toSeconds(pose.t),
                      trackingStateName(pose.state));
       }
@@ -130,7 +155,7 @@ int main(int argc, char** argv) {
       }
       was_initialized = initialized;
       if (pose.is_keyframe) report.noteKeyframes(pipeline.odometry().map());
-      ms_avg = i == 0 ? pipeline.timing().total_ms : 0.95 * ms_avg + 0.05 * pipeline.timing().total_ms;
+      ms_avg = i == 0 ? timing.total_ms : 0.95 * ms_avg + 0.05 * timing.total_ms;
       if (show && (i % 5 == 0 || i + 1 == frames)) progress(i + 1, frames, ms_avg, pose);
     }
     report.noteKeyframes(pipeline.odometry().map());

@@ -19,6 +19,14 @@ class SlamPipeline final : public FrameProcessor {
 
   void process(const RigFrameView& frame, PoseEstimate& out) override;
 
+  // The two stages of process(), for a caller that overlaps the front-end of the next frame with the odometry
+  // of this one (mcslam-run): computeFeatures() may run on another thread, into another FrameFeatures, while
+  // track() runs. Each fills its part of `timing` (features_ms; tracking_ms and optimization_ms).
+  void computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing);
+  void track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out, PipelineTiming& timing);
+  // A FrameFeatures sized for this pipeline (allocates).
+  FrameFeatures makeFrameFeatures() const { return FrameFeatures(rig_.size(), config_.orb.max_features); }
+
   const PipelineTiming& timing() const { return timing_; }
   const OdometryStats& stats() const { return odometry_.stats(); }
   const FrameFeatures& lastFeatures() const { return features_; }
