@@ -29,9 +29,6 @@ struct Renderer::Impl {
   SensorModel sensor;
   FrameContext ctx;
   std::vector<std::shared_ptr<const CameraLut>> luts;
-  // Per camera and pixel: the vignetting gain, 0 outside the lens's valid domain. Saves the sensor pass from
-  // streaming the 16-byte rays of the whole image again.
-  std::vector<std::vector<float>> vignettes;
   const CameraLut* lut = nullptr;
   std::vector<uint32_t> key;  // per pixel: surface hit by the centre ray
   std::vector<float> t;       // and its distance
@@ -45,7 +42,6 @@ struct Renderer::Impl {
     Image* image = nullptr;
     float gain = 1.f;
     uint32_t stream = 0;  // noise stream of this frame and camera
-    const float* vignette = nullptr;
   } out;
 
   void visibilityPass(int tile);
@@ -54,8 +50,9 @@ struct Renderer::Impl {
   // weight: share of this sub-exposure; accumulate: add to the radiance of the earlier ones; encode: last one,
   // write grey levels.
   void shadingPass(int tile, float weight, bool accumulate, bool encode, bool anti_aliasing);
-  void shadeRow(int y, int x0, int x1, bool anti_aliasing, const std::vector<Candidate>& cands, float* values) const;
-  bool uniformQuad(int x, int y, bool anti_aliasing) const;
+  void shadeRow(int y, int x0, int x1, bool anti_aliasing, const std::vector<Candidate>& cands, float* values,
+                float* gains) const;
+  bool sameNeighbours(int x, int y) const;
   float shadePixel(int x, int y, bool anti_aliasing, const std::vector<Candidate>& cands) const;
   float antiAliased(int x, int y, const std::vector<Candidate>& cands) const;
   bool isEdge(int x, int y) const;
@@ -177,21 +174,16 @@ float Renderer::Impl::antiAliased(int x, int y, const std::vector<Candidate>& ca
   return sum / static_cast<float>(n);
 }
 
-// Whether the four pixels from (x, y) (and, with anti-aliasing, their 14 neighbours) all see one surface that
-// shadeQuad handles. A hit implies a valid pixel: rays outside the lens's domain are never traced.
-bool Renderer::Impl::uniformQuad(int x, int y, bool anti_aliasing) const {
+// Whether the 14 neighbours of the four pixels from (x, y) all see the surface those see (then none of the four is
+// an edge).
+bool Renderer::Impl::sameNeighbours(int x, int y) const {
   const int W = lut->width, H = lut->height;
+  if (x == 0 || y == 0 || x + 4 >= W || y + 1 >= H) return false;
   const uint32_t* c = &key[static_cast<std::size_t>(y) * W + x];
-  const uint32_t k = c[0];
-  if (k == 0 || ((c[1] ^ k) | (c[2] ^ k) | (c[3] ^ k)) != 0) return false;
-  if (anti_aliasing) {
-    if (x == 0 || y == 0 || x + 4 >= W || y + 1 >= H) return false;
-    const uint32_t *a = c - W, *b = c + W;
-    uint32_t diff = (c[-1] ^ k) | (c[4] ^ k);
-    for (int l = -1; l <= 4; ++l) diff |= (a[l] ^ k) | (b[l] ^ k);
-    if (diff != 0) return false;
-  }
-  return ctx.quadShadable(k);
+  const uint32_t k = c[0], *a = c - W, *b = c + W;
+  uint32_t diff = (c[-1] ^ k) | (c[4] ^ k);
+  for (int l = -1; l <= 4; ++l) diff |= (a[l] ^ k) | (b[l] ^ k);
+  return diff == 0;
 }
 
 float Renderer::Impl::shadePixel(int x, int y, bool anti_aliasing, const std::vector<Candidate>& cands) const {
@@ -204,19 +196,28 @@ float Renderer::Impl::shadePixel(int x, int y, bool anti_aliasing, const std::ve
   return key[i] ? ctx.shade(key[i], t[i], d, r[3]) : ctx.sky(d);
 }
 
-// Radiance of pixels [x0, x1) of row y into values[0, x1 - x0). x0 is a multiple of 4 (tiles are).
+// Radiance of pixels [x0, x1) of row y into values[0, x1 - x0), their vignetting gains (0 outside the lens's
+// domain) into gains. x0 is a multiple of 4 (tiles are). Four pixels that see one light-mapped box face are shaded
+// together, those of them on an edge then anti-aliased one by one; a hit implies a valid pixel (rays outside the
+// lens's domain are never traced).
 void Renderer::Impl::shadeRow(int y, int x0, int x1, bool anti_aliasing, const std::vector<Candidate>& cands,
-                              float* values) const {
+                              float* values, float* gains) const {
   const std::size_t row = static_cast<std::size_t>(y) * lut->width;
-  for (int x = x0; x < x1;) {
-    if (x + 4 <= x1 && uniformQuad(x, y, anti_aliasing)) {
-      f4 b[4];
-      quadRays(x, y, 4, b);
-      store4(values + (x - x0), ctx.shadeQuad(key[row + x], load4(&t[row + x]), b, b[3]));
-      x += 4;
+  for (int x = x0; x < x1; x += 4) {
+    const int n = std::min(4, x1 - x);
+    f4 b[4];
+    quadRays(x, y, n, b);
+    store4(gains + (x - x0), b[3] > 0.f ? sensor.vignette(b[2]) : splat(0.f));
+    const uint32_t* k = &key[row + x];
+    float* v = values + (x - x0);
+    if (n == 4 && k[0] != 0 && ((k[1] ^ k[0]) | (k[2] ^ k[0]) | (k[3] ^ k[0])) == 0 && ctx.quadShadable(k[0])) {
+      store4(v, ctx.shadeQuad(k[0], load4(&t[row + x]), b, b[3]));
+      if (!anti_aliasing || sameNeighbours(x, y)) continue;
+      for (int l = 0; l < 4; ++l) {
+        if (isEdge(x + l, y)) v[l] = antiAliased(x + l, y, cands);
+      }
     } else {
-      values[x - x0] = shadePixel(x, y, anti_aliasing, cands);
-      ++x;
+      for (int l = 0; l < n; ++l) v[l] = shadePixel(x + l, y, anti_aliasing, cands);
     }
   }
 }
@@ -226,9 +227,9 @@ void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool e
   const int W = lut->width, H = lut->height, ts = lut->tile;
   const int tx = tile % lut->tiles_x, ty = tile / lut->tiles_x;
   const int x0 = tx * ts, x1 = std::min(W, x0 + ts), y1 = std::min(H, (ty + 1) * ts);
-  float values[64];  // tiles are at most 64 pixels wide
+  float values[64], gains[64];  // tiles are at most 64 pixels wide
   for (int y = ty * ts; y < y1; ++y) {
-    shadeRow(y, x0, x1, anti_aliasing, cands, values);
+    shadeRow(y, x0, x1, anti_aliasing, cands, values, gains);
     const std::size_t row = static_cast<std::size_t>(y) * W;
     uint8_t* grey = encode ? out.image->row(y) : nullptr;
     for (int x = x0; x < x1; x += 4) {
@@ -242,7 +243,7 @@ void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool e
       }
       uint8_t q[4];
       const uint32_t index = static_cast<uint32_t>(i);
-      sensor.encode4(v * out.gain, load4(out.vignette + i, n), out.stream, index, n == 4 ? grey + x : q);
+      sensor.encode4(v * out.gain, load4(gains + (x - x0), n), out.stream, index, n == 4 ? grey + x : q);
       if (n < 4) std::copy_n(q, n, grey + x);
     }
   }
@@ -259,12 +260,6 @@ Renderer::Renderer(std::shared_ptr<const World> world, Rig rig, RenderOptions op
   impl_ = std::make_unique<Impl>(options_, world_->data());
   for (const RigCamera& c : rig_.cameras) {
     impl_->luts.push_back(CameraLut::get(c.model, options_.tile_size, impl_->pool));
-    const CameraLut& lut = *impl_->luts.back();
-    std::vector<float>& v = impl_->vignettes.emplace_back(static_cast<std::size_t>(lut.width) * lut.height);
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const float* r = &lut.rays[4 * i];
-      v[i] = r[3] > 0.f ? impl_->sensor.vignette(r[2]) : 0.f;
-    }
   }
   // N-rooks pattern: every column and every row of an n x n grid holds one sample.
   const int n = options_.edge_samples;
@@ -306,8 +301,7 @@ void Renderer::render(int cam, const std::function<SE3(double)>& T_w_b_at, doubl
   if (subs > 1) m.radiance.resize(n);
   const int tiles = static_cast<int>(m.tile_cands.size());
   const uint64_t stream = hashOf(options_.seed, frame_key, static_cast<uint64_t>(cam));
-  m.out = {&image, static_cast<float>(exposureGain(cam, time_s)), static_cast<uint32_t>(stream ^ (stream >> 32)),
-           m.vignettes[cam].data()};
+  m.out = {&image, static_cast<float>(exposureGain(cam, time_s)), static_cast<uint32_t>(stream ^ (stream >> 32))};
   for (int s = 0; s < subs; ++s) {
     const double ts = subs == 1 ? time_s : time_s + blur * ((s + 0.5) / subs - 0.5);
     m.ctx.setup(T_w_b_at(ts) * rig_.T_b_c(cam), ts);

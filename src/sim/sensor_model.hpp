@@ -33,13 +33,14 @@ class SensorModel {
     const i4 level = toInt(v * static_cast<float>(kGammaSize - 1) + 0.5f);
     for (int l = 0; l < 4; ++l) out[l] = gamma_[level[l]];
   }
-  // Vignetting gain for a bearing whose optical-axis component is bz.
-  float vignette(float bz) const {
-    if (!options_.vignetting) return 1.f;
-    const float s2 = 1.f - bz * bz;  // sin^2 of the angle off the axis (beyond 90 degrees too)
-    const float g = 1.f - strength_ * std::min(s2, 1.f);
-    return bz < 0.f ? std::max(0.3f, g - strength_ * 0.5f * (-bz)) : std::max(0.3f, g);
+  // Vignetting gain for a bearing whose optical-axis component is bz (F: float, or f4 for four bearings).
+  template <class F>
+  F vignette(F bz) const {
+    const float s = options_.vignetting ? strength_ : 0.f;  // 0: gain 1 everywhere
+    const F g = 1.f - s * vmin(1.f - bz * bz, 1.f);          // 1 - s sin^2 of the angle off the axis (beyond 90 deg too)
+    return bz < 0.f ? vmax(g - s * 0.5f * (-bz), 0.3f) : vmax(g, 0.3f);
   }
+
 
  private:
   static constexpr uint32_t kGaussBits = 12;
