@@ -6,6 +6,31 @@
 
 namespace mcslam::sim {
 
+namespace {
+
+// Cylinders and turned boxes (rare): one lane at a time. Returns whether a lane's nearest hit changed.
+__attribute__((noinline)) bool slowTest(const FrameContext& ctx, const Candidate& c, int j, const RayPacket& rays,
+                                        f4& best, i4& best_key, i4& best_c) {
+  const detail::Prim& p = ctx.prim(static_cast<int>(c.prim));
+  bool changed = false;
+  for (int l = 0; l < 4; ++l) {
+    if (!(best[l] > 0.f)) continue;
+    const float d[3] = {rays.d[0][l], rays.d[1][l], rays.d[2][l]};
+    float dl[3], th;
+    int face;
+    p.toLocal(d, dl);
+    if (detail::intersectLocal(p, c.o, dl, detail::kRayEpsilon, best[l], th, face)) {
+      best[l] = th;
+      best_c[l] = j;
+      best_key[l] = static_cast<int32_t>(makeKey(static_cast<int>(c.prim), face));
+      changed = true;
+    }
+  }
+  return changed;
+}
+
+}  // namespace
+
 void tracePacket(const FrameContext& ctx, const std::vector<Candidate>& cands, const RayPacket& rays, int& hint,
                  uint32_t keys[4], float t[4]) {
   f4 inv[3];
@@ -14,45 +39,34 @@ void tracePacket(const FrameContext& ctx, const std::vector<Candidate>& cands, c
   f4 best = rays.active != 0 ? splat(INFINITY) : splat(0.f);
   i4 best_key = {0, 0, 0, 0};
   i4 best_c = {-1, -1, -1, -1};
-  float worst = INFINITY;  // largest best over the lanes: candidates beyond it cannot matter
+  float worst = hmax(best);  // largest best over the lanes: candidates beyond it cannot matter
   const f4 eps = splat(detail::kRayEpsilon);
   // Face entered through along each axis: travelling towards -axis enters through the + face (odd index).
   const i4 face_x = inv[0] < 0.f ? i4{1, 1, 1, 1} : i4{0, 0, 0, 0};
   const i4 face_y = inv[1] < 0.f ? i4{3, 3, 3, 3} : i4{2, 2, 2, 2};
   const i4 face_z = inv[2] < 0.f ? i4{5, 5, 5, 5} : i4{4, 4, 4, 4};
 
-  auto test = [&](int j) {
+  // Inlined, so that the packet's state stays in registers (as a called lambda it went through memory).
+  auto test = [&](int j) __attribute__((always_inline)) {
     const Candidate& c = cands[j];
-    if (c.fast) {
-      const f4 ax = (-c.h[0] - c.o[0]) * inv[0], bx = (c.h[0] - c.o[0]) * inv[0];
-      const f4 ay = (-c.h[1] - c.o[1]) * inv[1], by = (c.h[1] - c.o[1]) * inv[1];
-      const f4 az = (-c.h[2] - c.o[2]) * inv[2], bz = (c.h[2] - c.o[2]) * inv[2];
-      const f4 nx = vmin(ax, bx), ny = vmin(ay, by), nz = vmin(az, bz);
-      const f4 tn = vmax(nx, vmax(ny, nz));
-      const f4 tf = vmin(vmax(ax, bx), vmin(vmax(ay, by), vmax(az, bz)));
-      const i4 hit = (tn <= tf) & (tn > eps) & (tn < best);
-      if (!(hit[0] | hit[1] | hit[2] | hit[3])) return;
-      const int32_t base = static_cast<int32_t>(makeKey(static_cast<int>(c.prim), 0));
-      const i4 face = tn == nx ? face_x : (tn == ny ? face_y : face_z);
-      best = hit ? tn : best;
-      best_key = hit ? (face | base) : best_key;
-      best_c = hit ? i4{j, j, j, j} : best_c;
-    } else {  // cylinders and turned boxes: one lane at a time
-      const detail::Prim& p = ctx.prim(static_cast<int>(c.prim));
-      for (int l = 0; l < 4; ++l) {
-        if (!(best[l] > 0.f)) continue;
-        const float d[3] = {rays.d[0][l], rays.d[1][l], rays.d[2][l]};
-        float dl[3], th;
-        int face;
-        p.toLocal(d, dl);
-        if (detail::intersectLocal(p, c.o, dl, detail::kRayEpsilon, best[l], th, face)) {
-          best[l] = th;
-          best_c[l] = j;
-          best_key[l] = static_cast<int32_t>(makeKey(static_cast<int>(c.prim), face));
-        }
-      }
+    if (!c.fast) {
+      if (slowTest(ctx, c, j, rays, best, best_key, best_c)) worst = hmax(best);
+      return;
     }
-    worst = std::max(std::max(best[0], best[1]), std::max(best[2], best[3]));
+    const f4 ax = (-c.h[0] - c.o[0]) * inv[0], bx = (c.h[0] - c.o[0]) * inv[0];
+    const f4 ay = (-c.h[1] - c.o[1]) * inv[1], by = (c.h[1] - c.o[1]) * inv[1];
+    const f4 az = (-c.h[2] - c.o[2]) * inv[2], bz = (c.h[2] - c.o[2]) * inv[2];
+    const f4 nx = vmin(ax, bx), ny = vmin(ay, by), nz = vmin(az, bz);
+    const f4 tn = vmax(nx, vmax(ny, nz));
+    const f4 tf = vmin(vmax(ax, bx), vmin(vmax(ay, by), vmax(az, bz)));
+    const i4 hit = (tn <= tf) & (tn > eps) & (tn < best);
+    if (!any(hit)) return;
+    const int32_t base = static_cast<int32_t>(makeKey(static_cast<int>(c.prim), 0));
+    const i4 face = tn == nx ? face_x : (tn == ny ? face_y : face_z);
+    best = hit ? tn : best;
+    best_key = hit ? (face | base) : best_key;
+    best_c = hit ? i4{j, j, j, j} : best_c;
+    worst = hmax(best);
   };
 
   const int n = static_cast<int>(cands.size());

@@ -89,6 +89,15 @@ inline void transpose4(const f4 r[4], f4 c[4]) {
   c[3] = __builtin_shuffle(zw01, zw23, second);
 }
 
+// Whether any lane of a comparison result is true; the largest lane.
+inline bool any(i4 m) {
+  const i4 folded = m | __builtin_shuffle(m, i4{2, 3, 0, 1});
+  return (folded[0] | folded[1]) != 0;
+}
+inline float hmax(f4 a) {
+  const f4 folded = vmax(a, __builtin_shuffle(a, i4{2, 3, 0, 1}));
+  return folded[0] > folded[1] ? folded[0] : folded[1];
+}
 inline float sum(f4 a) { return (a[0] + a[1]) + (a[2] + a[3]); }
 
 }  // namespace mcslam::sim
