@@ -7,17 +7,23 @@
 
 namespace mcslam {
 
-FeatureWorkers::FeatureWorkers(const OrbOptions& options, const std::vector<ImageSize>& max_sizes, int threads) {
+FeatureWorkers::FeatureWorkers(const OrbOptions& options, const std::vector<ImageSize>& max_sizes, int threads)
+    : max_sizes_(max_sizes) {
   if (max_sizes.empty()) throw InputError("FeatureWorkers: cameras = 0: at least one camera is needed");
-  extractors_.reserve(max_sizes.size());
-  for (const ImageSize& size : max_sizes) extractors_.emplace_back(options, size.width, size.height);
+  ImageSize largest;
+  for (const ImageSize& size : max_sizes) {
+    largest.width = std::max(largest.width, size.width);
+    largest.height = std::max(largest.height, size.height);
+  }
   if (threads <= 0) {
     const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     threads = std::min(cameras(), cores);
   }
   threads = std::min(threads, cameras());  // a thread without a camera would only wait
+  extractors_.reserve(static_cast<size_t>(threads));
+  for (int i = 0; i < threads; ++i) extractors_.emplace_back(options, largest.width, largest.height);
   threads_.reserve(static_cast<size_t>(threads));
-  for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { run(); });
+  for (int i = 0; i < threads; ++i) threads_.emplace_back([this, i] { run(i); });
 }
 
 FeatureWorkers::~FeatureWorkers() {
@@ -42,18 +48,24 @@ void FeatureWorkers::extract(const ImageView* images, const bool* present, Featu
   work_done_.wait(lock, [this] { return remaining_ == 0; });
 }
 
-void FeatureWorkers::processCamera(int camera) {
+void FeatureWorkers::processCamera(int camera, OrbExtractor& extractor) {
   FeatureSet& out = out_[camera];
   OrbStatus result = OrbStatus::kOk;
-  if (present_[camera]) {
-    result = extractors_[static_cast<size_t>(camera)].extract(images_[camera], out);
+  const ImageSize& max_size = max_sizes_[static_cast<size_t>(camera)];
+  if (present_[camera] && out.capacity() >= extractor.options().max_features &&
+      (images_[camera].width > max_size.width || images_[camera].height > max_size.height)) {
+    out.clear();  // as an extractor sized for this camera alone would answer
+    result = OrbStatus::kImageTooLarge;
+  } else if (present_[camera]) {
+    result = extractor.extract(images_[camera], out);
   } else {
     out.clear();
   }
   if (status_ != nullptr) status_[camera] = result;
 }
 
-void FeatureWorkers::run() {
+void FeatureWorkers::run(int thread) {
+  OrbExtractor& extractor = extractors_[static_cast<size_t>(thread)];
   uint64_t seen = 0;
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
@@ -64,7 +76,7 @@ void FeatureWorkers::run() {
     while (next_camera_ < cameras()) {
       const int camera = next_camera_++;
       lock.unlock();
-      processCamera(camera);
+      processCamera(camera, extractor);
       lock.lock();
       if (--remaining_ == 0) work_done_.notify_one();
     }

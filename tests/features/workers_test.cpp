@@ -96,6 +96,22 @@ TEST(FeatureWorkers, AbsentCamerasGetNoFeatures) {
   EXPECT_EQ(out[4].count, 0);
 }
 
+TEST(FeatureWorkers, ImageLargerThanItsCameraIsRefusedEvenIfAnotherCameraIsThatLarge) {
+  // The extractors are shared and sized for the largest camera; the limit stays per camera.
+  FeatureWorkers workers(options(), rig().sizes, 2);
+  std::vector<FeatureSet> out = makeSets();
+  std::vector<ImageView> views = rig().views;
+  views[4] = rig().views[0];  // camera 0's image is larger than camera 4's size
+  const bool present[kCameras] = {true, true, true, true, true};
+  OrbStatus status[kCameras];
+  out[4].count = 7;
+  workers.extract(views.data(), present, out.data(), status);
+  EXPECT_EQ(status[0], OrbStatus::kOk);
+  EXPECT_GT(out[0].count, 0);
+  EXPECT_EQ(status[4], OrbStatus::kImageTooLarge);
+  EXPECT_EQ(out[4].count, 0);
+}
+
 TEST(FeatureWorkers, RigFramesAllocateNothingOnAnyThread) {
   ASSERT_TRUE(alloc::available());
   FeatureWorkers workers(options(), rig().sizes, 2);

@@ -1,8 +1,10 @@
 #pragma once
 // Per-camera ORB extraction on persistent worker threads, one rig frame at a time.
 //
-// One OrbExtractor per camera; one thread per camera, or a pool of hardware_concurrency() threads
-// when there are more cameras than cores (threads take the next camera from a shared counter).
+// One thread per camera, or a pool of hardware_concurrency() threads when there are more cameras than
+// cores (threads take the next camera from a shared counter). One OrbExtractor per thread, sized for the
+// largest camera: an extractor's buffers are scratch, so a camera's output does not depend on which
+// extractor ran it, and five cameras on two threads keep two extractors' buffers, not five.
 // extract() is the per-rig-frame barrier: it returns when every camera is done. The threads start in
 // the constructor and stop in the destructor; a frame allocates nothing. A camera's output depends
 // only on its image, never on which thread ran it.
@@ -34,15 +36,17 @@ class FeatureWorkers {
   // An absent camera gets zero features. status (optional, one per camera) receives each result.
   void extract(const ImageView* images, const bool* present, FeatureSet* out, OrbStatus* status = nullptr);
 
-  int cameras() const { return static_cast<int>(extractors_.size()); }
+  int cameras() const { return static_cast<int>(max_sizes_.size()); }
   int threads() const { return static_cast<int>(threads_.size()); }
-  const OrbExtractor& extractor(int camera) const { return extractors_[static_cast<size_t>(camera)]; }
+  // The extractor of worker thread `thread` (sized for the largest camera).
+  const OrbExtractor& extractor(int thread) const { return extractors_[static_cast<size_t>(thread)]; }
 
  private:
-  void run();
-  void processCamera(int camera);
+  void run(int thread);
+  void processCamera(int camera, OrbExtractor& extractor);
 
-  std::vector<OrbExtractor> extractors_;
+  std::vector<ImageSize> max_sizes_;     // per camera: an image larger than this is refused
+  std::vector<OrbExtractor> extractors_;  // per thread
   std::vector<std::thread> threads_;
 
   std::mutex mutex_;
