@@ -43,6 +43,7 @@ WindowLinearization::WindowLinearization(const WindowStorage& window, const Solv
   landmarks_.resize(cap.max_landmarks);
   refs_.resize(cap.max_observations);
   lin_.resize(cap.max_observations);
+  if (num_ext_vars_ > 0) je_.resize(cap.max_observations);
   prior_r_.resize(num_cameras_);
   prior_J_.resize(num_cameras_);
   S_.setZero(ld_, ld_);
@@ -153,7 +154,7 @@ void WindowLinearization::linearize(const WindowStorage& window, const Marginali
         if (select_landmarks) ref.active = false;
         o.r.setZero();
         o.Jp.setZero();
-        o.Je.setZero();
+        if (!je_.empty()) je_[k].setZero();
         o.Jl.setZero();
         continue;
       }
@@ -163,7 +164,7 @@ void WindowLinearization::linearize(const WindowStorage& window, const Marginali
       const double sw = std::sqrt(weight);
       o.r = sw * r;
       o.Jp = sw * J.pose.transpose();
-      o.Je = sw * J.extrinsic.transpose();
+      if (!je_.empty()) je_[k] = sw * J.extrinsic.transpose();
       o.Jl = sw * J.point.transpose();
       H.noalias() += o.Jl * o.Jl.transpose();
       ++valid;
@@ -289,14 +290,15 @@ void WindowLinearization::buildReducedSystem(double mu, const MarginalizationPri
         g_c_.segment<6>(6 * pb).noalias() += o.Jp * o.r;
         D_c_.segment<6>(6 * pb) += o.Jp.rowwise().squaredNorm();
       }
-      if (eb >= 0) {
-        W_[touch(eb)].noalias() += o.Je * o.Jl.transpose();
-        S_.block<6, 6>(6 * eb, 6 * eb).noalias() += o.Je * o.Je.transpose();
-        g_c_.segment<6>(6 * eb).noalias() += o.Je * o.r;
-        D_c_.segment<6>(6 * eb) += o.Je.rowwise().squaredNorm();
+      if (eb >= 0) {  // only when an extrinsic is refined: je_ is there
+        const ExtrinsicJacobian& Je = je_[k];
+        W_[touch(eb)].noalias() += Je * o.Jl.transpose();
+        S_.block<6, 6>(6 * eb, 6 * eb).noalias() += Je * Je.transpose();
+        g_c_.segment<6>(6 * eb).noalias() += Je * o.r;
+        D_c_.segment<6>(6 * eb) += Je.rowwise().squaredNorm();
       }
       if (pb >= 0 && eb >= 0) {  // pose blocks come before extrinsic blocks
-        S_.block<6, 6>(6 * pb, 6 * eb).noalias() += o.Jp * o.Je.transpose();
+        S_.block<6, 6>(6 * pb, 6 * eb).noalias() += o.Jp * je_[k].transpose();
         pattern_[size_t(pb) * max_blocks_ + eb] = 1;
       }
     }
@@ -339,7 +341,7 @@ void WindowLinearization::backSubstitute() {
       const ObservationLin& o = lin_[k];
       Vec2 v = Vec2::Zero();
       if (ref.pose_block >= 0) v.noalias() += o.Jp.transpose() * dx_c_.segment<6>(6 * ref.pose_block);
-      if (ref.ext_block >= 0) v.noalias() += o.Je.transpose() * dx_c_.segment<6>(6 * ref.ext_block);
+      if (ref.ext_block >= 0) v.noalias() += je_[k].transpose() * dx_c_.segment<6>(6 * ref.ext_block);
       t.noalias() += o.Jl * v;
     }
     L.dx.noalias() = -L.H_inv * t;

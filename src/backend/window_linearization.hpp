@@ -60,9 +60,9 @@ class WindowLinearization {
   struct ObservationLin {
     Vec2 r;                          // sqrt(weight) * whitened residual
     Eigen::Matrix<double, 6, 2> Jp;  // sqrt(weight) * (d r / d pose)^T
-    Eigen::Matrix<double, 6, 2> Je;  // ... extrinsic
     Eigen::Matrix<double, 3, 2> Jl;  // ... landmark
   };
+  using ExtrinsicJacobian = Eigen::Matrix<double, 6, 2>;  // ... extrinsic, in je_
   struct LandmarkLin {
     int slot;
     int begin, end;  // observation range
@@ -97,6 +97,9 @@ class WindowLinearization {
   int num_landmarks_ = 0;
   std::vector<ObservationRef> refs_;
   std::vector<ObservationLin> lin_;
+  // Per observation, parallel to lin_; only when an extrinsic is refined (otherwise no observation has
+  // an extrinsic block and this would be a third of lin_'s memory, never read).
+  std::vector<ExtrinsicJacobian> je_;
   int num_refs_ = 0;
   std::vector<Vec6> prior_r_;    // calibration prior per camera
   std::vector<Mat6> prior_J_;
