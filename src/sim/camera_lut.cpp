@@ -18,12 +18,7 @@ using Key = std::tuple<int, int, double, double, double, double, int, std::array
 std::shared_ptr<const CameraLut> compute(const CameraModel& m, int tile, ThreadPool& pool) {
   auto lut = std::make_shared<CameraLut>();
   const int W = m.width(), H = m.height();
-  lut->width = W;
-  lut->height = H;
-  lut->tile = tile;
-  lut->tiles_x = (W + tile - 1) / tile;
-  lut->tiles_y = (H + tile - 1) / tile;
-  lut->rays.assign(static_cast<std::size_t>(W) * H * 4, 0.f);
+  lut->layout(W, H, tile);
   std::vector<Vec3> bearing(static_cast<std::size_t>(W) * H, Vec3::Zero());
   std::vector<uint8_t> ok(static_cast<std::size_t>(W) * H, 0);
   pool.run(H, [&](int y) {
@@ -54,7 +49,7 @@ std::shared_ptr<const CameraLut> compute(const CameraModel& m, int tile, ThreadP
       };
       const double sx = step(1, 0), sy = step(0, 1);
       const double size = std::sqrt(std::max(sx, 1e-9) * std::max(sy, 1e-9));
-      float* r = &lut->rays[4 * i];
+      float* r = lut->ray(x, y);
       for (int k = 0; k < 3; ++k) r[k] = static_cast<float>(bearing[i][k]);
       r[3] = static_cast<float>(std::max(size, 1e-7));
     }
@@ -72,7 +67,7 @@ std::shared_ptr<const CameraLut> compute(const CameraModel& m, int tile, ThreadP
           const std::size_t i = static_cast<std::size_t>(y) * W + x;
           if (!ok[i]) continue;
           sum += bearing[i];
-          max_size = std::max(max_size, static_cast<double>(lut->rays[4 * i + 3]));
+          max_size = std::max(max_size, static_cast<double>(lut->ray(x, y)[3]));
         }
       }
       if (sum.squaredNorm() == 0) continue;
@@ -124,6 +119,20 @@ std::shared_ptr<const CameraLut> compute(const CameraModel& m, int tile, ThreadP
 }
 
 }  // namespace
+
+void CameraLut::layout(int w, int h, int tile_size) {
+  width = w;
+  height = h;
+  tile = tile_size;
+  tiles_x = (w + tile - 1) / tile;
+  tiles_y = (h + tile - 1) / tile;
+  const uint32_t ts = static_cast<uint32_t>(tile);
+  rays.assign(static_cast<std::size_t>(tiles_x) * tiles_y * ts * ts * 4, 0.f);
+  row_start_.resize(h);
+  for (int y = 0; y < h; ++y) row_start_[y] = (y / ts * tiles_x * ts + y % ts) * ts;
+  col_offset_.resize(w);
+  for (int x = 0; x < w; ++x) col_offset_[x] = x / ts * ts * ts + x % ts;
+}
 
 std::shared_ptr<const CameraLut> CameraLut::get(const CameraModel& m, int tile, ThreadPool& pool) {
   static std::mutex mutex;

@@ -91,7 +91,8 @@ void Renderer::Impl::visibilityPass(int tile) {
 
 void Renderer::Impl::quadRays(int x, int y, int n, f4 b[4]) const {
   f4 r[4];
-  for (int l = 0; l < 4; ++l) r[l] = l < n ? load4(lut->ray(x + l, y)) : splat(0.f);
+  const float* first = lut->ray(x, y);  // the quad lies in one tile row (tiles are multiples of 4 wide)
+  for (int l = 0; l < 4; ++l) r[l] = l < n ? load4(first + 4 * l) : splat(0.f);
   transpose4(r, b);
 }
 
