@@ -54,6 +54,31 @@ FaceCoords<T> boxFaceCoords(const FaceRecord& fr, const float o[3], T t, const T
           qb * fr.lm_v[0] + fr.lm_v[1], vabs(dl[fr.axis_n])};
 }
 
+// Corners i, i + 1, i + w, i + w + 1 of base.
+inline void cellCorners(const float* base, int i, int w, float& c00, float& c10, float& c01, float& c11) {
+  c00 = base[i];
+  c10 = base[i + 1];
+  c01 = base[i + w];
+  c11 = base[i + w + 1];
+}
+// The same per lane. Light-map cells (tens of centimetres) are much larger than a pixel's footprint, so the four
+// lanes nearly always share one cell: then four loads instead of sixteen.
+inline void cellCorners(const float* base, i4 i, int w, f4& c00, f4& c10, f4& c01, f4& c11) {
+  if (!any(i != i[0])) {
+    float a, b, c, d;
+    cellCorners(base, i[0], w, a, b, c, d);
+    c00 = splat(a);
+    c10 = splat(b);
+    c01 = splat(c);
+    c11 = splat(d);
+    return;
+  }
+  c00 = gather(base, i);
+  c10 = gather(base, i + 1);
+  c01 = gather(base, i + w);
+  c11 = gather(base, i + w + 1);
+}
+
 // Bilinear irradiance at light-map cell coordinates (lx, ly). F: float, or f4 for four points of one face.
 template <class F>
 F lightmapIrradiance(const detail::WorldData& w, const detail::LightmapRecord& lm, F lx, F ly) {
@@ -63,7 +88,8 @@ F lightmapIrradiance(const detail::WorldData& w, const detail::LightmapRecord& l
   const F fx = x - toFloat(x0), fy = y - toFloat(y0);
   const float* c = &w.lightmap_values[lm.offset];
   const auto i = y0 * lm.w + x0;
-  const F c00 = gather(c, i), c10 = gather(c, i + 1), c01 = gather(c, i + lm.w), c11 = gather(c, i + lm.w + 1);
+  F c00, c10, c01, c11;
+  cellCorners(c, i, lm.w, c00, c10, c01, c11);
   const F a = c00 + fx * (c10 - c00);
   const F b = c01 + fx * (c11 - c01);
   return a + fy * (b - a);
