@@ -79,7 +79,7 @@ void progress(std::size_t done, std::size_t total, double ms_per_frame, const Po
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
   std::string dataset_dir, calibration_path, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
-  bool quiet = false, print_config = false, sequential = false;
+  bool quiet = false, print_config = false, overlap = false;
   std::size_t max_frames = 0;
   app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
       ->required();
@@ -93,9 +93,9 @@ int main(int argc, char** argv) {
   app.add_option("--extrinsics", extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", quiet, "No progress bar");
-  app.add_flag("--sequential", sequential,
-               "Run the front-end of the next frame only after the odometry of this one (same output, slower; "
-               "by default they overlap on two threads)");
+  app.add_flag("--overlap", overlap,
+               "Run the front-end of the next frame while the odometry works on this one (same output; on our 2-core "
+               "machine faster for 2 cameras, slower for 5: see BENCHMARKS.md)");
   app.add_flag("--print-config", print_config,
                "Print the effective `slam:` configuration (defaults, --config, this dataset's rig) and exit");
   CLI11_PARSE(app, argc, argv);
@@ -114,7 +114,6 @@ int main(int argc, char** argv) {
       return 0;
     }
     SlamPipeline pipeline(ds.rig(), config);
-    const bool overlap = !sequential;
     const std::size_t frames = max_frames > 0 ? std::min(max_frames, ds.size()) : ds.size();
     run::RunReport report;
     const bool show = !quiet && ::isatty(STDERR_FILENO);
@@ -123,9 +122,8 @@ int main(int argc, char** argv) {
                    ds.rig().size(), ds.rig().size() == 1 ? "" : "s", frames);
     }
 
-    // The front-end of frame i+1 (image decoding, ORB, multi-view features) runs on its own thread while the
-    // odometry works on frame i: the two stages share no state, so the output is the same as one after the other
-    // (--sequential), only sooner.
+    // Frame i+1 is decoded and through the front-end on its own thread, either after the odometry of frame i or,
+    // with --overlap, during it: the two stages share no state, so the output is the same either way.
     FrameFeatures buffers[2] = {pipeline.makeFrameFeatures(), pipeline.makeFrameFeatures()};
     auto launch = [&](std::size_t i) {
       return std::async(std::launch::async, [&ds, &pipeline, &buffers, i] { return prepareFrame(ds, pipeline, i, buffers[i % 2]); });
