@@ -19,16 +19,15 @@ void checkKittiRig(const Rig& rig) {
     const CameraModel& m = rig.model(c);
     const auto& k = m.coeffs();
     if (m.distortion() != Distortion::None && (k[0] != 0 || k[1] != 0 || k[2] != 0 || k[3] != 0)) {
-      throw InputError("cam" + std::to_string(c) + ": distortion " + distortionName(m.distortion()) +
+      throw InputError(rig.cameras[c].name + ": distortion " + distortionName(m.distortion()) +
                        " with non-zero coefficients: the KITTI layout holds rectified images only (no distortion)");
     }
     const double angle = Eigen::AngleAxisd(R0.transpose() * rig.T_b_c(c).R).angle();
     if (angle > 1e-6) {
       char buf[160];
-      std::snprintf(buf, sizeof(buf),
-                    "cam%d: turned %.4f deg from cam0: the KITTI layout holds rectified cameras only (same orientation)",
-                    c, angle * 180.0 / M_PI);
-      throw InputError(buf);
+      std::snprintf(buf, sizeof(buf), ": turned %.4f deg from %s: the KITTI layout holds rectified cameras only (same orientation)",
+                    angle * 180.0 / M_PI, rig.cameras[0].name.c_str());
+      throw InputError(rig.cameras[c].name + buf);
     }
   }
 }
