@@ -94,8 +94,13 @@ void DatasetSource::emit(std::size_t i, uint64_t loop, uint64_t trigger_index, i
   std::vector<Image>& images = images_[cfg_.preload ? i : 0];
   std::vector<bool>& present = present_[cfg_.preload ? i : 0];
   if (!cfg_.preload) {
+    // Decoded straight into the cameras' write slots (their buffers lent to `images` for the call): no
+    // staging copy of a whole rig frame is kept, and no copy is made below.
+    images.resize(static_cast<std::size_t>(rings_->cameras()));
+    for (int c = 0; c < rings_->cameras(); ++c) std::swap(images[c], rings_->slot(c).image);
     load_error_.clear();
     dataset_.loadImages(i, images, present, &load_error_);
+    for (int c = 0; c < rings_->cameras(); ++c) std::swap(images[c], rings_->slot(c).image);
     if (!load_error_.empty()) {
       counters_.bad_frames.fetch_add(1, std::memory_order_relaxed);
       spdlog::warn("dataset frame {}: {}", i, load_error_);
@@ -107,14 +112,16 @@ void DatasetSource::emit(std::size_t i, uint64_t loop, uint64_t trigger_index, i
   for (int c = 0; c < rings_->cameras(); ++c) {
     if (c >= static_cast<int>(present.size()) || !present[c]) continue;
     const auto [w, h] = rings_->size(c);
-    if (images[c].width() != w || images[c].height() != h) {
+    CameraFrame& slot = rings_->slot(c);
+    const Image& image = cfg_.preload ? images[c] : slot.image;
+    if (image.width() != w || image.height() != h) {
       if (counters_.bad_frames.fetch_add(1, std::memory_order_relaxed) < 10)
         spdlog::warn("dataset frame {} cam{}: image is {}x{}, the calibration says {}x{}; skipped", i, c,
-                     images[c].width(), images[c].height(), w, h);
+                     image.width(), image.height(), w, h);
+      if (!cfg_.preload) slot.image.resize(w, h);  // the slot keeps its size (no allocation when it grew)
       continue;
     }
-    CameraFrame& slot = rings_->slot(c);
-    copyImage(images[c], slot.image);
+    if (cfg_.preload) copyImage(images[c], slot.image);
     const Timestamp stamp = entry.camera_stamps.size() > static_cast<std::size_t>(c) && entry.camera_stamps[c] != 0
                                 ? entry.camera_stamps[c]
                                 : entry.t;
