@@ -139,6 +139,7 @@ void OverlapMap::computePair(const Rig& rig, int i, int j) {
     offsets[cell + 1] = static_cast<int32_t>(cells.size());
   }
   if (!cells.empty()) {
+    cells.shrink_to_fit();  // kept for the whole run: not the push_back growth's spare capacity
     pair.offsets = std::move(offsets);
     pair.cells = std::move(cells);
   }
