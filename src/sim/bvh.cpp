@@ -55,6 +55,14 @@ void Bvh::build(const std::vector<Prim>& prims) {
   nodes_.reserve(2 * prims.size());
   nodes_.emplace_back();
   buildRange(prims, centroids, 0, 0, static_cast<int>(prims.size()));
+  spheres_.resize(nodes_.size());
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    const BvhNode& n = nodes_[i];
+    BvhSphere& b = spheres_[i];
+    for (int k = 0; k < 3; ++k) b.c[k] = 0.5f * (n.lo[k] + n.hi[k]);
+    const float e0 = n.hi[0] - n.lo[0], e1 = n.hi[1] - n.lo[1], e2 = n.hi[2] - n.lo[2];
+    b.r = 0.5f * std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+  }
 }
 
 // Fills node `self` for order_[begin, end); median split along the widest centroid axis. Children are allocated

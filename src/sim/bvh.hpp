@@ -16,6 +16,11 @@ struct BvhNode {
   int32_t count = 0;  // > 0 for leaves
 };
 
+// Bounding sphere of a node's box, for cone queries (computed once at build instead of at every visit).
+struct BvhSphere {
+  float c[3], r;
+};
+
 class Bvh {
  public:
   void build(const std::vector<Prim>& prims);
@@ -58,6 +63,7 @@ class Bvh {
  private:
   void buildRange(const std::vector<Prim>& prims, std::vector<float>& centroids, int self, int begin, int end);
   std::vector<BvhNode> nodes_;
+  std::vector<BvhSphere> spheres_;  // per node
   std::vector<int32_t> order_;
 };
 

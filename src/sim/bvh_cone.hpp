@@ -16,11 +16,9 @@ void Bvh::cone(const std::vector<Prim>& prims, const float apex[3], const float 
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
-    const BvhNode& n = nodes_[stack[--top]];
-    const float c[3] = {0.5f * (n.lo[0] + n.hi[0]), 0.5f * (n.lo[1] + n.hi[1]), 0.5f * (n.lo[2] + n.hi[2])};
-    const float e0 = n.hi[0] - n.lo[0], e1 = n.hi[1] - n.lo[1], e2 = n.hi[2] - n.lo[2];
-    const float r = 0.5f * std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
-    if (!sphereMeetsCone(apex, axis, cos_a, sin_a, c, r)) continue;
+    const int i = stack[--top];
+    const BvhNode& n = nodes_[i];
+    if (!sphereMeetsCone(apex, axis, cos_a, sin_a, spheres_[i].c, spheres_[i].r)) continue;
     if (n.count > 0) {
       for (int i = 0; i < n.count; ++i) {
         const int idx = order_[n.first + i];
