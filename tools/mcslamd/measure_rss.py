@@ -7,7 +7,10 @@ publish count from the shared-memory header (docs/pose-protocol.md: u64 `publish
 Prints the samples and a summary: RSS after warm-up, at the end, the maximum, and the growth between.
 
   tools/mcslamd/measure_rss.py --mcslamd build/bin/mcslamd [--dataset DIR] [--frames 10000]
-                               [--rate fastest|recorded] [--interval 1.0]
+                               [--rate fastest|recorded] [--interval 1.0] [--breakdown]
+
+--breakdown: before stopping, split the resident set from /proc/<pid>/status and /proc/<pid>/smaps
+(anonymous vs file-backed, the largest mappings, the shared libraries' share).
 """
 import argparse
 import mmap
@@ -65,6 +68,29 @@ def rss_kb(pid):
     return 0
 
 
+def breakdown(pid, top=12):
+    """Resident set by mapping from /proc/<pid>/smaps: what is anonymous (heap, mmap'ed buffers, thread
+    stacks, libraries' relocated data) and what is file-backed (library and executable pages)."""
+    with open("/proc/%d/status" % pid) as f:
+        status = {l.split(":")[0]: l.split(":")[1].strip() for l in f if l.startswith(("VmRSS", "RssAnon", "RssFile"))}
+    print("breakdown: VmRSS %s, RssAnon %s, RssFile %s" % (status.get("VmRSS"), status.get("RssAnon"), status.get("RssFile")))
+    by_name, name, libs = {}, None, set()
+    with open("/proc/%d/smaps" % pid) as f:
+        for line in f:
+            head = line.split()
+            if head and "-" in head[0] and len(head) >= 5 and all(c in "0123456789abcdef-" for c in head[0]):
+                name = head[5] if len(head) > 5 else "[anonymous mmap]"
+                if name.startswith("/") and ".so" in name:
+                    libs.add(name)
+            elif line.startswith("Rss:"):
+                by_name[name] = by_name.get(name, 0) + int(head[1])
+    lib_kb = sum(v for k, v in by_name.items() if k in libs)
+    print("  %d shared libraries mapped, %.1f MB resident (text, data and their relocated pages)"
+          % (len(libs), lib_kb / 1024.0))
+    for k, v in sorted(by_name.items(), key=lambda kv: -kv[1])[:top]:
+        print("  %8.1f MB  %s" % (v / 1024.0, k))
+
+
 def published(shm_name):
     try:
         with open("/dev/shm" + shm_name, "rb") as f:
@@ -83,6 +109,7 @@ def main():
     ap.add_argument("--interval", type=float, default=1.0)
     ap.add_argument("--warmup-frames", type=int, default=1000, help="frames before the 'after warm-up' sample")
     ap.add_argument("--slam", default="{}", help="the slam: section (YAML flow text)")
+    ap.add_argument("--breakdown", action="store_true", help="print where the resident set is before stopping")
     args = ap.parse_args()
 
     work = tempfile.mkdtemp(prefix="mcslamd-rss-")
@@ -114,6 +141,8 @@ def main():
             print("%8.1f s  %7d poses  VmRSS %8.1f MB" % (samples[-1][0], n, kb / 1024.0), flush=True)
             if n >= args.frames:
                 break
+        if args.breakdown:
+            breakdown(proc.pid)
         proc.send_signal(signal.SIGTERM)
         proc.wait(timeout=30)
         log.close()
