@@ -2,7 +2,8 @@
 // A rendered simulator dataset for the daemon tests and benchmarks with the real pipeline: the ISEC rig's
 // five overlapping front cameras in the indoor world, ground robot, seed 1, written with exportDataset
 // (camchain.yaml, images, groundtruth.txt). Rendering costs seconds, so it is cached under the build
-// tree (build/test-cache/<name>) and reused; a half-written folder is never taken for a finished one.
+// tree (build/test-cache/<name>) and reused; a half-written folder is never taken for a finished one. The name
+// carries the build time of the simulator library, so a rebuilt renderer never meets images of an older one.
 #include <unistd.h>
 
 #include <filesystem>
@@ -18,9 +19,13 @@ inline constexpr int kSimDatasetFrames = 50;
 
 inline std::string cachedSimDataset(int frames = kSimDatasetFrames, double rate_hz = 10) {
   namespace fs = std::filesystem;
+  const fs::path build = fs::path(binPath("mcslamd")).parent_path().parent_path();
+  std::error_code ec;
+  const auto renderer_built = fs::last_write_time(build / "lib" / "libmcslam_sim.a", ec);
   const std::string name = "daemon-isec5-indoor-ground-" + std::to_string(frames) + "-at-" +
-                           std::to_string(static_cast<int>(rate_hz * 1000)) + "mHz";
-  const fs::path cache = fs::path(binPath("mcslamd")).parent_path().parent_path() / "test-cache";
+                           std::to_string(static_cast<int>(rate_hz * 1000)) + "mHz-sim" +
+                           (ec ? std::string("unknown") : std::to_string(renderer_built.time_since_epoch().count()));
+  const fs::path cache = build / "test-cache";
   const fs::path dir = cache / name;
   if (fs::exists(dir / "complete")) return dir.string();
   sim::SimulationConfig cfg;  // isec, indoor, ground, seed 1
@@ -35,7 +40,6 @@ inline std::string cachedSimDataset(int frames = kSimDatasetFrames, double rate_
   fs::create_directories(tmp);
   sim::exportDataset(simulation, tmp.string(), options);
   writeFile((tmp / "complete").string(), "rendered by tests/platform/sim_dataset_fixture.hpp\n");
-  std::error_code ec;
   fs::rename(tmp, dir, ec);  // another test process may have won the race: then use its folder
   if (ec) fs::remove_all(tmp);
   return dir.string();
