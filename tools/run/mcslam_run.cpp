@@ -31,24 +31,32 @@ YAML::Node slamSection(const std::string& path) {
   return root;
 }
 
+// Frame i's images, decoded (on a thread of its own, one frame ahead of the front-end).
 struct LoadedFrame {
   std::vector<Image> images;
   std::vector<bool> present;
+  std::string error;  // an unreadable image (its camera is then absent)
 };
 
-// Frame i through the front-end: images decoded, features computed into `out`.
-struct PreparedFrame {
-  PipelineTiming timing;  // features_ms
-  double wall_ms = 0;     // decoding and front-end
-  std::string error;      // an unreadable image (its camera is then absent)
-};
-
-PreparedFrame prepareFrame(const Dataset& ds, SlamPipeline& pipeline, std::size_t i, FrameFeatures& out) {
-  const auto start = std::chrono::steady_clock::now();
-  PreparedFrame p;
+LoadedFrame loadFrame(const Dataset& ds, std::size_t i) {
   LoadedFrame f;
   f.images.resize(ds.rig().size());
-  ds.loadImages(i, f.images, f.present, &p.error);
+  ds.loadImages(i, f.images, f.present, &f.error);
+  return f;
+}
+
+// Frame i through the front-end: features computed into `out`.
+struct PreparedFrame {
+  PipelineTiming timing;  // features_ms
+  double wall_ms = 0;     // front-end, as SlamPipeline::process counts it (decoding not included)
+  std::string error;
+};
+
+PreparedFrame prepareFrame(const Dataset& ds, SlamPipeline& pipeline, std::size_t i, const LoadedFrame& f,
+                           FrameFeatures& out) {
+  const auto start = std::chrono::steady_clock::now();
+  PreparedFrame p;
+  p.error = f.error;
   std::vector<ImageView> views(ds.rig().size());
   std::unique_ptr<bool[]> present(new bool[ds.rig().size()]);
   for (int c = 0; c < ds.rig().size(); ++c) {
@@ -122,26 +130,30 @@ int main(int argc, char** argv) {
                    ds.rig().size(), ds.rig().size() == 1 ? "" : "s", frames);
     }
 
-    // Frame i+1 is decoded and through the front-end on its own thread, either after the odometry of frame i or,
-    // with --overlap, during it: the two stages share no state, so the output is the same either way.
+    // Images are decoded one frame ahead on their own thread. The front-end of frame i+1 runs after the odometry of
+    // frame i or, with --overlap, during it (on another thread): the two stages share no state, so the output is the
+    // same either way.
     FrameFeatures buffers[2] = {pipeline.makeFrameFeatures(), pipeline.makeFrameFeatures()};
-    auto launch = [&](std::size_t i) {
-      return std::async(std::launch::async, [&ds, &pipeline, &buffers, i] { return prepareFrame(ds, pipeline, i, buffers[i % 2]); });
+    std::future<LoadedFrame> next_load = std::async(std::launch::async, loadFrame, std::cref(ds), std::size_t{0});
+    auto frontEnd = [&](std::size_t i) {  // takes frame i's images and starts decoding frame i+1
+      LoadedFrame f = next_load.get();
+      if (i + 1 < frames) next_load = std::async(std::launch::async, loadFrame, std::cref(ds), i + 1);
+      return prepareFrame(ds, pipeline, i, f, buffers[i % 2]);
     };
     const auto wall_start = std::chrono::steady_clock::now();
-    std::future<PreparedFrame> pending = launch(0);
+    std::future<PreparedFrame> pending;
+    if (overlap) pending = std::async(std::launch::async, frontEnd, std::size_t{0});
     bool was_initialized = false;
     double ms_avg = 0;
     for (std::size_t i = 0; i < frames; ++i) {
-      PreparedFrame prepared = pending.get();
-      if (overlap && i + 1 < frames) pending = launch(i + 1);
+      PreparedFrame prepared = overlap ? pending.get() : frontEnd(i);
+      if (overlap && i + 1 < frames) pending = std::async(std::launch::async, frontEnd, i + 1);
       if (!prepared.error.empty()) std::fprintf(stderr, "%smcslam-run: frame %zu: %s\n", show ? "\n" : "", i, prepared.error.c_str());
       PoseEstimate pose;
       PipelineTiming timing = prepared.timing;
       const auto track_start = std::chrono::steady_clock::now();
       pipeline.track(buffers[i % 2], i, ds.frames()[i].t, pose, timing);
       timing.total_ms = prepared.wall_ms + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - track_start).count();
-      if (!overlap && i + 1 < frames) pending = launch(i + 1);
       // Losing and regaining track are worth a line of their own (the stats file lists them all).
       if (report.add(pose, timing) && !quiet && i > 0) {
         std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s\n", show ? "\r\033[K" : "", i, toSeconds(pose.t),
