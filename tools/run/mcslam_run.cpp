@@ -103,7 +103,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "No progress bar");
   app.add_flag("--overlap", overlap,
                "Run the front-end of the next frame while the odometry works on this one (same output; on our 2-core "
-               "machine faster for 2 cameras, slower for 5: see BENCHMARKS.md)");
+               "machine 15-20% faster when nothing else runs, slower under competing load: see BENCHMARKS.md)");
   app.add_flag("--print-config", print_config,
                "Print the effective `slam:` configuration (defaults, --config, this dataset's rig) and exit");
   CLI11_PARSE(app, argc, argv);
