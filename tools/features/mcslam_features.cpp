@@ -7,6 +7,7 @@
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/json_writer.hpp"
 #include "mcslam/dataset/dataset.hpp"
+#include "mcslam/pipeline/dataset_frame.hpp"
 #include "mcslam/pipeline/front_end.hpp"
 
 using namespace mcslam;
@@ -79,20 +80,11 @@ int main(int argc, char** argv) {
     }
     const PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", ds.rig());
     FrontEnd front(ds.rig(), config);
-    std::vector<Image> images(ds.rig().size());
-    std::vector<bool> present;
-    std::string error;
-    ds.loadImages(frame, images, present, &error);
-    if (!error.empty()) std::fprintf(stderr, "mcslam-features: %s\n", error.c_str());
-    std::vector<ImageView> views(ds.rig().size());
-    std::unique_ptr<bool[]> flags(new bool[ds.rig().size()]);
-    for (int c = 0; c < ds.rig().size(); ++c) {
-      flags[c] = present[c];
-      views[c] = present[c] ? images[c].view() : ImageView{};
-    }
-    RigFrameView view{ds.frames()[frame].t, frame, ds.rig().size(), views.data(), flags.get()};
+    DatasetFrame images;
+    images.load(ds, frame);
+    if (!images.error().empty()) std::fprintf(stderr, "mcslam-features: %s\n", images.error().c_str());
     FrameFeatures features(ds.rig().size(), config.orb.max_features);
-    front.compute(view, features);
+    front.compute(images.view(), features);
     if (json) {
       printJson(features, frame);
     } else {

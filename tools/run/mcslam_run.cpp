@@ -11,6 +11,7 @@
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/dataset/dataset.hpp"
+#include "mcslam/pipeline/dataset_frame.hpp"
 #include "mcslam/pipeline/slam_pipeline.hpp"
 #include "run_report.hpp"
 
@@ -31,17 +32,9 @@ YAML::Node slamSection(const std::string& path) {
   return root;
 }
 
-// Frame i's images, decoded (on a thread of its own, one frame ahead of the front-end).
-struct LoadedFrame {
-  std::vector<Image> images;
-  std::vector<bool> present;
-  std::string error;  // an unreadable image (its camera is then absent)
-};
-
-LoadedFrame loadFrame(const Dataset& ds, std::size_t i) {
-  LoadedFrame f;
-  f.images.resize(ds.rig().size());
-  ds.loadImages(i, f.images, f.present, &f.error);
+DatasetFrame loadFrame(const Dataset& ds, std::size_t i) {
+  DatasetFrame f;
+  f.load(ds, i);
   return f;
 }
 
@@ -49,27 +42,14 @@ LoadedFrame loadFrame(const Dataset& ds, std::size_t i) {
 struct PreparedFrame {
   PipelineTiming timing;  // features_ms
   double wall_ms = 0;     // front-end, as SlamPipeline::process counts it (decoding not included)
-  std::string error;
+  std::string error;      // an unreadable image (its camera is then absent)
 };
 
-PreparedFrame prepareFrame(const Dataset& ds, SlamPipeline& pipeline, std::size_t i, const LoadedFrame& f,
-                           FrameFeatures& out) {
+PreparedFrame prepareFrame(SlamPipeline& pipeline, const DatasetFrame& f, FrameFeatures& out) {
   const auto start = std::chrono::steady_clock::now();
   PreparedFrame p;
-  p.error = f.error;
-  std::vector<ImageView> views(ds.rig().size());
-  std::unique_ptr<bool[]> present(new bool[ds.rig().size()]);
-  for (int c = 0; c < ds.rig().size(); ++c) {
-    present[c] = f.present[c];
-    views[c] = f.present[c] ? f.images[c].view() : ImageView{};
-  }
-  RigFrameView view;
-  view.t = ds.frames()[i].t;
-  view.sequence = i;
-  view.cameras = ds.rig().size();
-  view.images = views.data();
-  view.present = present.get();
-  pipeline.computeFeatures(view, out, p.timing);
+  p.error = f.error();
+  pipeline.computeFeatures(f.view(), out, p.timing);
   p.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return p;
 }
@@ -134,11 +114,11 @@ int main(int argc, char** argv) {
     // frame i or, with --overlap, during it (on another thread): the two stages share no state, so the output is the
     // same either way.
     FrameFeatures buffers[2] = {pipeline.makeFrameFeatures(), pipeline.makeFrameFeatures()};
-    std::future<LoadedFrame> next_load = std::async(std::launch::async, loadFrame, std::cref(ds), std::size_t{0});
+    std::future<DatasetFrame> next_load = std::async(std::launch::async, loadFrame, std::cref(ds), std::size_t{0});
     auto frontEnd = [&](std::size_t i) {  // takes frame i's images and starts decoding frame i+1
-      LoadedFrame f = next_load.get();
+      const DatasetFrame f = next_load.get();
       if (i + 1 < frames) next_load = std::async(std::launch::async, loadFrame, std::cref(ds), i + 1);
-      return prepareFrame(ds, pipeline, i, f, buffers[i % 2]);
+      return prepareFrame(pipeline, f, buffers[i % 2]);
     };
     const auto wall_start = std::chrono::steady_clock::now();
     std::future<PreparedFrame> pending;
