@@ -11,7 +11,7 @@
 #include "mcslam/core/error.hpp"
 #include "mcslam/dataset/dataset.hpp"
 #include "mcslam/odometry/initializer.hpp"
-#include "mcslam/pipeline/frame_processor.hpp"
+#include "mcslam/pipeline/dataset_frame.hpp"
 #include "mcslam/pipeline/front_end.hpp"
 #include "mcslam/pipeline/pipeline_config.hpp"
 
@@ -21,32 +21,17 @@ namespace {
 
 class FeatureSource {
  public:
-  FeatureSource(const Dataset& ds, const PipelineConfig& config)
-      : ds_(ds), front_end_(ds.rig(), config), views_(ds.rig().size()), present_(new bool[ds.rig().size()]) {}
+  FeatureSource(const Dataset& ds, const PipelineConfig& config) : ds_(ds), front_end_(ds.rig(), config) {}
   int capacity() const { return front_end_.capacityPerCamera(); }
   void compute(std::size_t i, FrameFeatures& out) {
-    std::string error;
-    ds_.loadImages(i, images_, present_flags_, &error);
-    for (int c = 0; c < ds_.rig().size(); ++c) {
-      present_[c] = present_flags_[c];
-      views_[c] = present_flags_[c] ? images_[c].view() : ImageView{};
-    }
-    RigFrameView view;
-    view.t = ds_.frames()[i].t;
-    view.sequence = i;
-    view.cameras = ds_.rig().size();
-    view.images = views_.data();
-    view.present = present_.get();
-    front_end_.compute(view, out);
+    frame_.load(ds_, i);
+    front_end_.compute(frame_.view(), out);
   }
 
  private:
   const Dataset& ds_;
   FrontEnd front_end_;
-  std::vector<Image> images_;
-  std::vector<bool> present_flags_;
-  std::vector<ImageView> views_;
-  std::unique_ptr<bool[]> present_;
+  DatasetFrame frame_;
 };
 
 const SE3* poseAt(const Trajectory& gt, Timestamp t) {
@@ -84,9 +69,9 @@ int main(int argc, char** argv) {
         source.compute(r + gap, cur);
         Initializer init(ds.rig(), config.odometry, source.capacity());
         SE3 T;
-        init.feed(ref, r, T);
-        init.feed(cur, r + gap, T);
-        // The same estimate as feed() makes, but with the check that decides shown instead of applied.
+        init.feed(ref, r, T);  // the reference
+        init.matchToReference(cur);
+        // The estimate feed() would make from these matches, with the check that decides shown instead of applied.
         RelativePoseOptions ro = init.relativePoseOptions(r + gap);
         const double bar = ro.max_relative_scale_sigma;
         ro.max_relative_scale_sigma = INFINITY;

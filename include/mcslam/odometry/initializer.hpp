@@ -32,14 +32,15 @@ class Initializer {
   // Why the last attempt waited (for logs).
   RelativePoseStatus lastStatus() const { return last_status_; }
   int lastMatches() const { return last_matches_; }
-  // The reference-to-frame matches of the last feed() (for diagnostics: tools/study/init_probe.cpp).
+  // Matches the frame to the reference by descriptor, camera by camera (what feed() estimates the relative pose
+  // from); the matches are then in lastCorrespondences(). Needs a reference (a first feed()).
+  int matchToReference(const FrameFeatures& f);
+  // The reference-to-frame matches of the last feed() or matchToReference() (tools/study/init_probe.cpp).
   const std::vector<RelativeCorrespondence>& lastCorrespondences() const { return correspondences_; }
   // The relative-pose options feed() uses for a frame (the bearing noise follows the rig's focal length).
   RelativePoseOptions relativePoseOptions(uint64_t frame_index) const;
 
  private:
-  int matchToReference(const FrameFeatures& f);
-
   const Rig& rig_;
   OdometryOptions options_;
   FrameFeatures reference_;
