@@ -10,6 +10,7 @@
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/dataset/rig_frame_sync.hpp"
 
 namespace mcslam {
 
@@ -72,14 +73,6 @@ void placeImage(const std::string& source, const fs::path& target, bool must_be_
   if (ec) throw InputError(target.string() + ": cannot copy " + source + ": " + ec.message());
 }
 
-std::string formatSeconds(Timestamp ns) {
-  char buf[48];
-  const Timestamp whole = ns / 1000000000, frac = ns % 1000000000;
-  if (ns < 0) return std::to_string(toSeconds(ns));
-  std::snprintf(buf, sizeof(buf), "%lld.%09lld", static_cast<long long>(whole), static_cast<long long>(frac));
-  return buf;
-}
-
 std::vector<std::optional<SE3>> groundTruthPerFrame(const Dataset& dataset) {
   std::vector<std::optional<SE3>> out(dataset.size());
   if (!dataset.groundTruth()) return out;
@@ -96,6 +89,9 @@ std::vector<std::optional<SE3>> groundTruthPerFrame(const Dataset& dataset) {
   return out;
 }
 
+namespace {
+
+// The images of every camera over all rig frames.
 std::vector<std::vector<CameraImage>> imagesPerCamera(const Dataset& dataset) {
   std::vector<std::vector<CameraImage>> out(dataset.rig().size());
   for (const RigFrameEntry& f : dataset.frames()) {
@@ -106,11 +102,11 @@ std::vector<std::vector<CameraImage>> imagesPerCamera(const Dataset& dataset) {
   return out;
 }
 
-namespace {
-
-// camN/data.csv and camN/data/<ns>.<ext> of every camera (ASL and EuRoC share this part).
-void writeAslCameras(const Dataset& dataset, const fs::path& root, DatasetExportReport& report) {
-  const auto images = imagesPerCamera(dataset);
+// camN/data.csv and camN/data/<ns>.<ext> of every camera (ASL and EuRoC share this part); returns the images
+// written, per camera.
+std::vector<std::vector<CameraImage>> writeAslCameras(const Dataset& dataset, const fs::path& root,
+                                                      DatasetExportReport& report) {
+  auto images = imagesPerCamera(dataset);
   for (int c = 0; c < dataset.rig().size(); ++c) {
     const fs::path cam = root / ("cam" + std::to_string(c));
     createFolder(cam / "data");
@@ -124,6 +120,7 @@ void writeAslCameras(const Dataset& dataset, const fs::path& root, DatasetExport
     writeTextFile(cam / "data.csv", csv);
   }
   report.frames_written = dataset.size();
+  return images;
 }
 
 // Median period of one camera's images, in Hz (EuRoC's rate_hz); 0 when it cannot be told.
@@ -169,10 +166,9 @@ void exportAsl(const Dataset& dataset, const fs::path& root, DatasetExportReport
 void exportEuroc(const Dataset& dataset, const fs::path& root, DatasetExportReport& report) {
   const Rig& rig = dataset.rig();
   const fs::path mav0 = root / "mav0";
-  writeAslCameras(dataset, mav0, report);
+  const auto images = writeAslCameras(dataset, mav0, report);
   // EuRoC's body frame B: the IMU when the calibration has one, else the first written camera.
   const SE3 T_b_B = rig.T_b_imu ? *rig.T_b_imu : rig.T_b_c(0);
-  const auto images = imagesPerCamera(dataset);
   for (int c = 0; c < rig.size(); ++c) {
     writeTextFile(mav0 / ("cam" + std::to_string(c)) / "sensor.yaml",
                   eurocSensorYaml(rig.model(c), T_b_B.inverse() * rig.T_b_c(c), cameraRateHz(images[c]), c));

@@ -6,7 +6,6 @@
 #include <vector>
 
 #include "mcslam/dataset/dataset_export.hpp"
-#include "mcslam/dataset/rig_frame_sync.hpp"
 
 namespace mcslam::detail {
 
@@ -16,12 +15,8 @@ void createFolder(const std::filesystem::path& dir);
 void writeTextFile(const std::filesystem::path& path, const std::string& text);
 // Hard link or copy of an image file; must_be_png re-encodes other formats to PNG.
 void placeImage(const std::string& source, const std::filesystem::path& target, bool must_be_png);
-// Exact decimal seconds of a time stamp ("12.300000001").
-std::string formatSeconds(Timestamp ns);
 // The ground-truth pose (body frame) of every rig frame, matched by time within the sync tolerance.
 std::vector<std::optional<SE3>> groundTruthPerFrame(const Dataset& dataset);
-// The images of every camera over all rig frames.
-std::vector<std::vector<CameraImage>> imagesPerCamera(const Dataset& dataset);
 
 // Throws InputError naming the camera when the rig is not one KITTI's calib.txt can describe.
 void checkKittiRig(const Rig& rig);

@@ -88,7 +88,7 @@ void exportKitti(const Dataset& dataset, const fs::path& root, DatasetExportRepo
       placeImage(f.image_paths[c], root / ("image_" + std::to_string(c)) / name, true);
       ++report.images_written;
     }
-    times += formatSeconds(f.t) + "\n";
+    times += toSecondsString(f.t) + "\n";
     if (gt[i]) poses.push_back({f.t, *gt[i] * T_b_c0});
     every_pose = every_pose && gt[i].has_value();
     ++report.frames_written;

@@ -54,15 +54,6 @@ bool parseSecondsToNs(const std::string& s, Timestamp& out) {
   return true;
 }
 
-std::string formatNs(Timestamp t) {
-  char buf[48];
-  const char* sign = t < 0 ? "-" : "";
-  const int64_t a = t < 0 ? -t : t;
-  std::snprintf(buf, sizeof(buf), "%s%lld.%09lld", sign, static_cast<long long>(a / 1000000000),
-                static_cast<long long>(a % 1000000000));
-  return buf;
-}
-
 std::size_t countWords(const std::string& line) {
   std::istringstream in(line);
   std::string w;
@@ -126,7 +117,7 @@ std::string formatTumTrajectory(const Trajectory& traj) {
   char buf[256];
   for (const StampedPose& p : traj) {
     const Eigen::Quaterniond q = p.T_w_b.quaternion();
-    std::snprintf(buf, sizeof(buf), "%s %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", formatNs(p.t).c_str(), p.T_w_b.t.x(),
+    std::snprintf(buf, sizeof(buf), "%s %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", toSecondsString(p.t).c_str(), p.T_w_b.t.x(),
                   p.T_w_b.t.y(), p.T_w_b.t.z(), q.x(), q.y(), q.z(), q.w());
     os << buf;
   }
