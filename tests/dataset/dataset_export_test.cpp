@@ -39,6 +39,17 @@ std::string writeAsl(const test::TempDir& dir, const Rig& rig, int skip_camera =
   return root;
 }
 
+// The message of the InputError the export throws (empty, and a failure, when it accepts the data).
+std::string exportError(const Dataset& dataset, DatasetLayoutKind layout, const std::string& out) {
+  try {
+    exportDataset(dataset, layout, out);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "the export into " << out << " was accepted";
+  return "";
+}
+
 void expectSamePose(const SE3& a, const SE3& b, double tol) {
   EXPECT_LT((a.t - b.t).norm(), tol);
   EXPECT_LT(Eigen::AngleAxisd(a.R.transpose() * b.R).angle(), tol);
@@ -145,36 +156,24 @@ TEST(DatasetExport, KittiRefusesDistortedOrTurnedCamerasBeforeWritingAnything) {
   Rig distorted = test::smallRig(2);
   distorted.cameras[1].model = CameraModel(test::kWidth, test::kHeight, 20, 20, 7.5, 5.5, Distortion::RadTan, {-0.2, 0.05, 0, 0});
   const Dataset a = Dataset::open(writeAsl(dir, distorted));
-  try {
-    exportDataset(a, DatasetLayoutKind::Kitti, dir.file("kitti"));
-    FAIL() << "a distorted camera was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("cam1: distortion radtan"), std::string::npos) << e.what();
-  }
+  const std::string distorted_error = exportError(a, DatasetLayoutKind::Kitti, dir.file("kitti"));
+  EXPECT_NE(distorted_error.find("cam1: distortion radtan"), std::string::npos) << distorted_error;
   EXPECT_FALSE(fs::exists(dir.file("kitti")));
 
   test::TempDir dir2("export_kitti_turned");
   Rig turned = test::smallRig(2);
   turned.cameras[1].T_b_c.R = Eigen::AngleAxisd(0.01, Vec3::UnitY()).toRotationMatrix();
   const Dataset b = Dataset::open(writeAsl(dir2, turned));
-  try {
-    exportDataset(b, DatasetLayoutKind::Kitti, dir2.file("kitti"));
-    FAIL() << "a turned camera was accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("cam1: turned 0.5730 deg"), std::string::npos) << e.what();
-  }
+  const std::string turned_error = exportError(b, DatasetLayoutKind::Kitti, dir2.file("kitti"));
+  EXPECT_NE(turned_error.find("cam1: turned 0.5730 deg"), std::string::npos) << turned_error;
 }
 
 TEST(DatasetExport, RefusesAnOutputFolderThatHoldsSomething) {
   test::TempDir dir("export_exists");
   const Dataset asl = Dataset::open(writeAsl(dir, test::smallRig(1)));
   test::writeFile(dir.file("out/keep.txt"), "mine");
-  try {
-    exportDataset(asl, DatasetLayoutKind::Euroc, dir.file("out"));
-    FAIL() << "wrote into a folder that holds a file";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("already exists"), std::string::npos) << e.what();
-  }
+  const std::string error = exportError(asl, DatasetLayoutKind::Euroc, dir.file("out"));
+  EXPECT_NE(error.find("already exists"), std::string::npos) << error;
   EXPECT_EQ(test::readFile(dir.file("out/keep.txt")), "mine");
   EXPECT_FALSE(fs::exists(dir.file("out/mav0")));
 }

@@ -81,10 +81,10 @@ TEST_F(RunLayouts, EveryLayoutGivesTheSameTrajectoryAndItMatchesItsGroundTruth) 
   EXPECT_NE(stats.find("\"state_changes\": [\n    {\n      \"frame\": 0,"), std::string::npos) << stats;
   EXPECT_NE(stats.find("\"state\": \"tracking\""), std::string::npos) << stats;
   // And each matches the ground truth its own layout carries (TUM body poses, EuRoC state csv, KITTI poses.txt).
-  for (const char* layout : {"asl", "euroc", "kitti"}) {
+  for (const auto& [layout, trajectory] : {std::pair{"asl", &asl}, std::pair{"euroc", &euroc}, std::pair{"kitti", &kitti}}) {
     const Dataset ds = Dataset::open(dir_->file(layout));
     ASSERT_TRUE(ds.groundTruth()) << layout;
-    const ApeResult ape = computeApe(*ds.groundTruth(), layout == std::string("asl") ? asl : layout == std::string("euroc") ? euroc : kitti, {});
+    const ApeResult ape = computeApe(*ds.groundTruth(), *trajectory, {});
     EXPECT_EQ(ape.errors.size(), static_cast<std::size_t>(kFrames)) << layout;
     EXPECT_GT(ape.data.ref_path_length, 2.0) << layout;  // the robot really moved
     EXPECT_LT(ape.stats.rmse, 0.02) << layout << ": ATE " << ape.stats.rmse << " m over " << ape.data.ref_path_length << " m";
