@@ -1,12 +1,12 @@
 // Dataset::open: detect the layout, read the calibration (or the override), list each selected camera's
 // images, assemble rig frames, read the ground truth. Dataset::loadImages reads one rig frame's images.
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 
 #include "dataset_layout.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/dataset/dataset.hpp"
+#include "mcslam/dataset/image_file.hpp"
 #include "mcslam/dataset/rig_frame_sync.hpp"
 
 namespace mcslam {
@@ -101,20 +101,19 @@ int Dataset::loadImages(std::size_t i, std::vector<Image>& images, std::vector<b
   for (int c = 0; c < n; ++c) {
     const std::string& path = frame.image_paths[c];
     if (path.empty()) continue;
-    const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (grey.empty()) {
-      report(path + ": cannot read image (missing, unreadable or not an image); " + rig_.cameras[c].name + " left out");
+    Image& img = images[c];
+    try {
+      readGreyImageFile(path, img);  // binary PGM: no allocation once img has the size
+    } catch (const InputError& e) {
+      report(std::string(e.what()) + "; " + rig_.cameras[c].name + " left out");
       continue;
     }
     const CameraModel& m = rig_.model(c);
-    if (grey.cols != m.width() || grey.rows != m.height()) {
-      report(path + ": image is " + std::to_string(grey.cols) + "x" + std::to_string(grey.rows) + " but the calibration of " +
+    if (img.width() != m.width() || img.height() != m.height()) {
+      report(path + ": image is " + std::to_string(img.width()) + "x" + std::to_string(img.height()) + " but the calibration of " +
              rig_.cameras[c].name + " says " + std::to_string(m.width()) + "x" + std::to_string(m.height()) + "; left out");
       continue;
     }
-    Image& img = images[c];
-    img.resize(grey.cols, grey.rows);
-    for (int y = 0; y < grey.rows; ++y) std::copy_n(grey.ptr<uint8_t>(y), grey.cols, img.row(y));
     present[c] = true;
     ++loaded;
   }

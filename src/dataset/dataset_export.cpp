@@ -10,6 +10,7 @@
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/dataset/image_file.hpp"
 #include "mcslam/dataset/rig_frame_sync.hpp"
 
 namespace mcslam {
@@ -21,6 +22,12 @@ DatasetLayoutKind parseDatasetLayout(const std::string& name) {
   if (name == "euroc") return DatasetLayoutKind::Euroc;
   if (name == "kitti") return DatasetLayoutKind::Kitti;
   throw InputError("unknown dataset layout '" + name + "' (supported: asl, euroc, kitti)");
+}
+
+ExportImages parseExportImages(const std::string& name) {
+  if (name == "original") return ExportImages::Original;
+  if (name == "pgm") return ExportImages::Pgm;
+  throw InputError("unknown image format '" + name + "' (supported: original, pgm)");
 }
 
 const char* datasetLayoutName(DatasetLayoutKind kind) {
@@ -105,15 +112,22 @@ std::vector<std::vector<CameraImage>> imagesPerCamera(const Dataset& dataset) {
 // camN/data.csv and camN/data/<ns>.<ext> of every camera (ASL and EuRoC share this part); returns the images
 // written, per camera.
 std::vector<std::vector<CameraImage>> writeAslCameras(const Dataset& dataset, const fs::path& root,
-                                                      DatasetExportReport& report) {
+                                                      const DatasetExportOptions& options, DatasetExportReport& report) {
   auto images = imagesPerCamera(dataset);
+  const bool pgm = options.images == ExportImages::Pgm;
+  Image pixels;  // reused for every image re-written as PGM
   for (int c = 0; c < dataset.rig().size(); ++c) {
     const fs::path cam = root / ("cam" + std::to_string(c));
     createFolder(cam / "data");
     std::string csv = "#timestamp [ns],filename\n";
     for (const CameraImage& im : images[c]) {
-      const std::string name = std::to_string(im.t) + fs::path(im.path).extension().string();
-      placeImage(im.path, cam / "data" / name, false);
+      const std::string name = std::to_string(im.t) + (pgm ? std::string(".pgm") : fs::path(im.path).extension().string());
+      if (pgm) {
+        readGreyImageFile(im.path, pixels);
+        writePgmFile((cam / "data" / name).string(), pixels.view());
+      } else {
+        placeImage(im.path, cam / "data" / name, false);
+      }
       csv += std::to_string(im.t) + "," + name + "\n";
       ++report.images_written;
     }
@@ -149,13 +163,14 @@ std::string eurocSensorYaml(const CameraModel& m, const SE3& T_B_c, double rate_
   return os.str();
 }
 
-void exportAsl(const Dataset& dataset, const fs::path& root, DatasetExportReport& report) {
+void exportAsl(const Dataset& dataset, const fs::path& root, const DatasetExportOptions& options,
+               DatasetExportReport& report) {
   const Rig& rig = dataset.rig();
   const SE3 T_b_c0 = rig.T_b_c(0);
   Rig out = rig;
   out.rebase(T_b_c0.inverse());  // the written camchain's body is its cam0
   writeKalibrRig(out, (root / "camchain.yaml").string());
-  writeAslCameras(dataset, root, report);
+  writeAslCameras(dataset, root, options, report);
   if (!dataset.groundTruth()) return;
   Trajectory gt = *dataset.groundTruth();
   for (StampedPose& p : gt) p.T_w_b = p.T_w_b * T_b_c0;
@@ -163,10 +178,11 @@ void exportAsl(const Dataset& dataset, const fs::path& root, DatasetExportReport
   report.ground_truth_poses = gt.size();
 }
 
-void exportEuroc(const Dataset& dataset, const fs::path& root, DatasetExportReport& report) {
+void exportEuroc(const Dataset& dataset, const fs::path& root, const DatasetExportOptions& options,
+                 DatasetExportReport& report) {
   const Rig& rig = dataset.rig();
   const fs::path mav0 = root / "mav0";
-  const auto images = writeAslCameras(dataset, mav0, report);
+  const auto images = writeAslCameras(dataset, mav0, options, report);
   // EuRoC's body frame B: the IMU when the calibration has one, else the first written camera.
   const SE3 T_b_B = rig.T_b_imu ? *rig.T_b_imu : rig.T_b_c(0);
   for (int c = 0; c < rig.size(); ++c) {
@@ -191,13 +207,19 @@ void exportEuroc(const Dataset& dataset, const fs::path& root, DatasetExportRepo
 }  // namespace
 }  // namespace detail
 
-DatasetExportReport exportDataset(const Dataset& dataset, DatasetLayoutKind layout, const std::string& out_dir) {
+DatasetExportReport exportDataset(const Dataset& dataset, DatasetLayoutKind layout, const std::string& out_dir,
+                                  const DatasetExportOptions& options) {
   DatasetExportReport report;
-  if (layout == DatasetLayoutKind::Kitti) detail::checkKittiRig(dataset.rig());  // before anything is written
+  if (layout == DatasetLayoutKind::Kitti) {  // refused before anything is written
+    if (options.images != ExportImages::Original)
+      throw InputError(out_dir + ": the KITTI layout holds PNG images only (image_N/000000.png); PGM images are for "
+                       "the asl and euroc layouts");
+    detail::checkKittiRig(dataset.rig());
+  }
   detail::prepareOutputFolder(out_dir);
   switch (layout) {
-    case DatasetLayoutKind::Asl: detail::exportAsl(dataset, out_dir, report); break;
-    case DatasetLayoutKind::Euroc: detail::exportEuroc(dataset, out_dir, report); break;
+    case DatasetLayoutKind::Asl: detail::exportAsl(dataset, out_dir, options, report); break;
+    case DatasetLayoutKind::Euroc: detail::exportEuroc(dataset, out_dir, options, report); break;
     case DatasetLayoutKind::Kitti: detail::exportKitti(dataset, out_dir, report); break;
   }
   return report;

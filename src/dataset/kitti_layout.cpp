@@ -6,13 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <unordered_set>
 
 #include "dataset_layout.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/dataset/image_file.hpp"
 
 namespace mcslam::detail {
 
@@ -86,11 +86,11 @@ class KittiLayout : public DatasetLayout {
       const Mat3 K = it->second.leftCols<3>();
       const Vec3 t = K.triangularView<Eigen::Upper>().solve(it->second.col(3));  // x_k = x_rect0 + t_k
       if (k == 0) t0 = t;
-      const cv::Size size = firstImageSize(k);
+      const Image first = firstImage(k);
       RigCamera c;
       c.name = "cam" + std::to_string(k);
       c.source_index = k;
-      c.model = CameraModel(size.width, size.height, K(0, 0), K(1, 1), K(0, 2), K(1, 2), Distortion::None);
+      c.model = CameraModel(first.width(), first.height(), K(0, 0), K(1, 1), K(0, 2), K(1, 2), Distortion::None);
       c.T_b_c = SE3(Mat3::Identity(), t0 - t);  // body = cam0
       rig.cameras.push_back(c);
     }
@@ -149,14 +149,19 @@ class KittiLayout : public DatasetLayout {
     return *times_;
   }
 
-  cv::Size firstImageSize(int k) const {
+  // The first image of camera k, which tells its resolution (calib.txt does not).
+  Image firstImage(int k) const {
     const std::vector<Timestamp>& t = times();
     for (std::size_t i = 0; i < t.size(); ++i) {
       const fs::path p = cameraDir(k) / imageName(i);
       if (!fs::exists(p)) continue;
-      const cv::Mat img = cv::imread(p.string(), cv::IMREAD_GRAYSCALE);
-      if (img.empty()) throw InputError(p.string() + ": cannot read image (needed for the resolution of cam" + std::to_string(k) + ")");
-      return img.size();
+      Image img;
+      try {
+        readGreyImageFile(p.string(), img);
+      } catch (const InputError& e) {
+        throw InputError(std::string(e.what()) + " (needed for the resolution of cam" + std::to_string(k) + ")");
+      }
+      return img;
     }
     throw InputError(cameraDir(k).string() + ": none of the " + std::to_string(t.size()) + " images of " + timesPath() +
                      " is there (expected 000000.png, ...)");

@@ -4,11 +4,11 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "hash.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/dataset/image_file.hpp"
 #include "texture_kinds.hpp"
 #include "texture_paint.hpp"
 #include "thread_pool.hpp"
@@ -28,8 +28,9 @@ bool isImageFile(const fs::path& p) {
 }
 
 MipTexture photoTexture(const std::string& path) {
-  cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (grey.empty()) throw InputError(path + ": cannot read image");
+  Image photo;
+  readGreyImageFile(path, photo);  // PNG and JPEG through the image codec module, loaded only here
+  const cv::Mat grey(photo.height(), photo.width(), CV_8UC1, photo.data());
   const int side = std::min(grey.cols, grey.rows);  // centre square crop
   cv::Mat square = grey(cv::Rect((grey.cols - side) / 2, (grey.rows - side) / 2, side, side));
   cv::Mat small;

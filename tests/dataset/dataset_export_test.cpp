@@ -1,5 +1,6 @@
 // Export into the three layouts, checked by reading the output back with our own readers: the same rig,
-// frames, images and ground truth must come out (a round trip through each layout).
+// frames, images and ground truth must come out (a round trip through each layout). With PGM images (the convert
+// command's --images pgm) the pixels must come out unchanged.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -40,9 +41,10 @@ std::string writeAsl(const test::TempDir& dir, const Rig& rig, int skip_camera =
 }
 
 // The message of the InputError the export throws (empty, and a failure, when it accepts the data).
-std::string exportError(const Dataset& dataset, DatasetLayoutKind layout, const std::string& out) {
+std::string exportError(const Dataset& dataset, DatasetLayoutKind layout, const std::string& out,
+                        const DatasetExportOptions& options = {}) {
   try {
-    exportDataset(dataset, layout, out);
+    exportDataset(dataset, layout, out, options);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -176,6 +178,72 @@ TEST(DatasetExport, RefusesAnOutputFolderThatHoldsSomething) {
   EXPECT_NE(error.find("already exists"), std::string::npos) << error;
   EXPECT_EQ(test::readFile(dir.file("out/keep.txt")), "mine");
   EXPECT_FALSE(fs::exists(dir.file("out/mav0")));
+}
+
+// The pixels of every image of `a` and `b` (same frames and cameras) are equal; b's images are binary PGM files.
+void expectSamePixelsInPgm(const Dataset& a, const Dataset& b) {
+  ASSERT_EQ(a.size(), b.size());
+  std::vector<Image> ia, ib;
+  std::vector<bool> pa, pb;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    std::string error;
+    EXPECT_EQ(a.loadImages(i, ia, pa, &error), b.loadImages(i, ib, pb, &error)) << error;
+    ASSERT_EQ(pa, pb) << "frame " << i;
+    for (int c = 0; c < a.rig().size(); ++c) {
+      if (!pa[c]) continue;
+      EXPECT_EQ(fs::path(b.frames()[i].image_paths[c]).extension(), ".pgm");
+      EXPECT_EQ(test::readFile(b.frames()[i].image_paths[c]).substr(0, 2), "P5");
+      ASSERT_EQ(ia[c].view().width, ib[c].view().width);
+      EXPECT_TRUE(std::equal(ia[c].data(), ia[c].data() + ia[c].width() * ia[c].height(), ib[c].data())) << "frame " << i;
+    }
+  }
+}
+
+TEST(DatasetExport, PgmImagesRoundTripThroughAslAndEurocWithTheSamePixels) {
+  test::TempDir dir("export_pgm");
+  const Dataset png = Dataset::open(writeAsl(dir, test::smallRig(2), /*skip_camera=*/1));
+  DatasetExportOptions pgm;
+  pgm.images = ExportImages::Pgm;
+  const DatasetExportReport r = exportDataset(png, DatasetLayoutKind::Asl, dir.file("asl_pgm"), pgm);
+  EXPECT_EQ(r.images_written, static_cast<std::size_t>(2 * kFrames - 1));
+  const Dataset asl = Dataset::open(dir.file("asl_pgm"));
+  expectSamePixelsInPgm(png, asl);
+  ASSERT_TRUE(asl.groundTruth());
+  EXPECT_EQ(asl.groundTruth()->size(), static_cast<std::size_t>(kFrames));
+  // PGM to PGM again, into EuRoC.
+  exportDataset(asl, DatasetLayoutKind::Euroc, dir.file("euroc_pgm"), pgm);
+  expectSamePixelsInPgm(png, Dataset::open(dir.file("euroc_pgm")));
+}
+
+TEST(DatasetExport, KittiRefusesPgmImagesBeforeWritingAnything) {
+  test::TempDir dir("export_kitti_pgm");
+  const Dataset asl = Dataset::open(writeAsl(dir, test::smallRig(2)));
+  DatasetExportOptions pgm;
+  pgm.images = ExportImages::Pgm;
+  const std::string error = exportError(asl, DatasetLayoutKind::Kitti, dir.file("kitti"), pgm);
+  EXPECT_NE(error.find("KITTI layout holds PNG images only"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir.file("kitti")));
+}
+
+TEST(DatasetExport, ConvertCommandWritesPgmImagesAndRefusesAnUnknownFormat) {
+  test::TempDir dir("export_cli");
+  const std::string src = writeAsl(dir, test::smallRig(2));
+  std::string out;
+  const std::string tool = test::binPath("mcslam-dataset") + " convert " + src + " --layout euroc --out ";
+  ASSERT_EQ(test::runCommand(tool + dir.file("euroc") + " --images pgm", &out), 0) << out;
+  expectSamePixelsInPgm(Dataset::open(src), Dataset::open(dir.file("euroc")));
+  // The default keeps the files as they are (hard links here).
+  ASSERT_EQ(test::runCommand(tool + dir.file("euroc_original"), &out), 0) << out;
+  const Dataset original = Dataset::open(dir.file("euroc_original"));
+  EXPECT_TRUE(fs::equivalent(original.frames()[0].image_paths[1], Dataset::open(src).frames()[0].image_paths[1]));
+  EXPECT_EQ(test::runCommand(tool + dir.file("tiff") + " --images tiff", &out), 2);
+  EXPECT_NE(out.find("unknown image format 'tiff' (supported: original, pgm)"), std::string::npos) << out;
+}
+
+TEST(DatasetExport, ImageFormatNames) {
+  EXPECT_EQ(parseExportImages("pgm"), ExportImages::Pgm);
+  EXPECT_EQ(parseExportImages("original"), ExportImages::Original);
+  EXPECT_THROW(parseExportImages("PNG"), InputError);
 }
 
 TEST(DatasetExport, LayoutNames) {

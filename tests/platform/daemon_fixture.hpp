@@ -1,5 +1,6 @@
 #pragma once
-// Shared by the daemon tests: a tiny ASL dataset written with mcslam::AslDatasetWriter, and config text.
+// Shared by the daemon tests: a tiny ASL dataset written with mcslam::AslDatasetWriter (PNG, or converted to
+// PGM), and config text.
 #include <random>
 #include <sstream>
 #include <string>
@@ -7,6 +8,7 @@
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/dataset/dataset.hpp"
+#include "mcslam/dataset/dataset_export.hpp"
 
 namespace mcslam::test {
 
@@ -36,6 +38,17 @@ inline std::string writeSmallDataset(const std::string& dir, int cameras, int fr
       writer.writeImage(c, 1000000000000ll + f * period_ns, img.view());
     }
   writer.close();
+  return dir;
+}
+
+// The same dataset with its images as binary PGM (what mcslam-dataset convert --images pgm writes), in `dir`; the
+// PNG original goes to `dir`_png.
+inline std::string writeSmallPgmDataset(const std::string& dir, int cameras, int frames, int width = 64,
+                                        int height = 48) {
+  const std::string png = writeSmallDataset(dir + "_png", cameras, frames, width, height);
+  DatasetExportOptions options;
+  options.images = ExportImages::Pgm;
+  exportDataset(Dataset::open(png), DatasetLayoutKind::Asl, dir, options);
   return dir;
 }
 

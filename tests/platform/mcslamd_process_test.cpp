@@ -3,8 +3,9 @@
 // over shared memory and over UDP and they equal each other and the trajectory file the daemon writes;
 // SIGTERM ends it cleanly within 2 s with the trajectory complete and the refined extrinsics written; the
 // trajectory is within centimetres of the simulator's ground truth.
-// Also: no WATCHDOG=1 while no frame is processed, and a bad configuration ends start-up with one
-// message naming the key (exit status 2).
+// Also: no WATCHDOG=1 while no frame is processed, a bad configuration ends start-up with one
+// message naming the key (exit status 2), and OpenCV's imgcodecs (with its ~110 libraries) is mapped only when
+// the replay meets a PNG, never for PGM.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -296,6 +297,28 @@ TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
   EXPECT_EQ(notify.count("WATCHDOG=1"), 0) << "watchdog kept alive without progress";
   ::kill(pid, SIGINT);
   EXPECT_EQ(waitExit(pid, 20), 0) << readAll(dir.file("log.txt"));
+}
+
+TEST(McslamdProcess, ImageCodecIsMappedOnlyWhenTheReplayMeetsAPng) {
+  test::TempDir dir("mcslamd-codec");
+  test::writeSmallPgmDataset(dir.file("pgm"), 2, 5);  // and its PNG original in pgm_png
+  for (const std::string data : {"pgm", "pgm_png"}) {
+    NotifyListener notify(dir.file(data + ".sock"));
+    ASSERT_TRUE(notify.ok());
+    const std::string config = test::writeFile(dir.file(data + ".yaml"),
+        "status_interval_s: 0.1\nsource:\n  type: dataset\n  dataset:\n    path: " + data +
+        "\n    rate: fastest\n    at_end: loop\npublish:\n  shm:\n    enabled: false\noutput:\n  directory: out_" + data + "\n");
+    const std::string log = dir.file(data + ".log");
+    const pid_t pid = spawnDaemon(config, dir.file(data + ".sock"), "400000", log);
+    // WATCHDOG=1 is sent only once frames are processed: their images were read by then.
+    ASSERT_TRUE(waitFor([&] { return notify.count("WATCHDOG=1") >= 1; })) << readAll(log);
+    const std::string maps = readAll("/proc/" + std::to_string(pid) + "/maps");
+    const bool png = data == "pgm_png";
+    EXPECT_EQ(maps.find("libopencv_imgcodecs") != std::string::npos, png) << data;
+    EXPECT_EQ(maps.find("mcslam_image_codec.so") != std::string::npos, png) << data;
+    ::kill(pid, SIGTERM);
+    EXPECT_EQ(waitExit(pid, 20), 0) << readAll(log);
+  }
 }
 
 TEST(McslamdProcess, BadConfigEndsStartupWithOneMessageNamingTheKey) {

@@ -94,26 +94,32 @@ int main(int argc, char** argv) {
                                  "rate_hz, ground_truth_poses, ground_truth_path_m, warnings)");
   info->add_option("--cameras", cameras, "Only these cameras, by calibration index, e.g. 0,1");
 
-  std::string layout, out;
+  std::string layout, out, images = "original";
   auto* convert = app.add_subcommand(
       "convert",
       "Write the dataset in another layout: asl (camchain.yaml, camN/), euroc (mav0/, sensor.yaml per camera, IMU or "
       "cam0 as body) or kitti (rectified cameras only: image_N/, calib.txt, times.txt, poses.txt). Images are "
-      "hard-linked (or copied), never re-encoded except non-PNG images for KITTI.");
+      "hard-linked (or copied), never re-encoded except non-PNG images for KITTI, unless --images pgm.");
   convert->add_option("DATASET", dir, "Dataset folder to read (any layout)")->required();
   convert->add_option("--layout", layout, "asl, euroc or kitti")->required();
   convert->add_option("--out", out, "Output folder (must not exist or be empty)")->required();
   convert->add_option("--cameras", cameras, "Write only these cameras, by calibration index, e.g. 1,2 (the first "
                                             "becomes the written cam0)");
+  convert->add_option("--images", images,
+                      "original (hard links of the files) or pgm (every image written as binary 8-bit PGM, asl and "
+                      "euroc only: a replay that needs no image codec, e.g. for mcslamd)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     DatasetOptions options;
     if (!cameras.empty()) options.cameras = parseCameraList(cameras);
     if (convert->parsed()) {
       const DatasetLayoutKind kind = parseDatasetLayout(layout);  // before the (slower) indexing of the input
+      DatasetExportOptions export_options;
+      export_options.images = parseExportImages(images);
       const Dataset ds = Dataset::open(dir, options);
       for (const std::string& w : ds.warnings()) std::fprintf(stderr, "mcslam-dataset: warning: %s\n", w.c_str());
-      const DatasetExportReport r = exportDataset(ds, kind, out);
+      const DatasetExportReport r = exportDataset(ds, kind, out, export_options);
       for (const std::string& w : r.warnings) std::fprintf(stderr, "mcslam-dataset: warning: %s\n", w.c_str());
       std::printf("%s (%s) -> %s (%s): %zu rig frames, %zu images, %zu ground-truth poses\n", dir.c_str(),
                   ds.format().c_str(), out.c_str(), datasetLayoutName(kind), r.frames_written, r.images_written,

@@ -11,7 +11,10 @@
 //           Only rectified rigs: pinhole cameras without distortion, all with cam0's orientation, at most 4;
 //           only rig frames with every camera present (KITTI has no way to say an image is missing).
 // Images are hard-linked when the output is on the same file system, copied otherwise (bytes unchanged);
-// KITTI's non-PNG sources are re-encoded to PNG (lossless, grey).
+// KITTI's non-PNG sources are re-encoded to PNG (lossless, grey). With ExportImages::Pgm (ASL and EuRoC) every
+// image is written as binary 8-bit PGM instead, which replays without the image codec module (image_file.hpp).
+//
+// Library mcslam_dataset_export (it links OpenCV imgcodecs, which mcslam_dataset does not).
 #include <string>
 #include <vector>
 
@@ -33,8 +36,21 @@ struct DatasetExportReport {
   std::vector<std::string> warnings;  // e.g. ground truth not written because frames lack a pose
 };
 
+// How the images are written: Original = the files as they are (hard links or copies), Pgm = decoded and written
+// as binary 8-bit PGM (<ns>.pgm; grey, lossless).
+enum class ExportImages { Original, Pgm };
+
+// "original", "pgm" -> kind; throws InputError naming the text otherwise.
+ExportImages parseExportImages(const std::string& name);
+
+struct DatasetExportOptions {
+  ExportImages images = ExportImages::Original;
+};
+
 // Writes `dataset` (its cameras, as opened: a camera subset stays a subset) into `out_dir`, which must not
-// exist or be empty. Throws InputError naming the folder, camera or field when the layout cannot hold the data.
-DatasetExportReport exportDataset(const Dataset& dataset, DatasetLayoutKind layout, const std::string& out_dir);
+// exist or be empty. Throws InputError naming the folder, camera or field when the layout cannot hold the data
+// (KITTI with ExportImages::Pgm: its images are PNG by definition).
+DatasetExportReport exportDataset(const Dataset& dataset, DatasetLayoutKind layout, const std::string& out_dir,
+                                  const DatasetExportOptions& options = {});
 
 }  // namespace mcslam
