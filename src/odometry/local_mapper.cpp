@@ -1,5 +1,7 @@
 #include "mcslam/odometry/local_mapper.hpp"
 
+#include "backend_worker.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -42,14 +44,20 @@ backend::SolverOptions solverOptions(const OdometryOptions& o, bool monocular) {
 }  // namespace
 
 LocalMapper::LocalMapper(const Rig& rig, const OdometryOptions& options, Map& map, int max_features_per_camera)
-    : rig_(rig), options_(options), map_(map), capacity_(max_features_per_camera), monocular_(rig.size() == 1) {
+    : rig_(rig),
+      options_(options),
+      map_(map),
+      band_index_(max_features_per_camera, options.levels),
+      capacity_(max_features_per_camera),
+      monocular_(rig.size() == 1) {
   const int cams = rig.size();
   touched_.resize(map.landmarkCapacity());
   touched_flag_.assign(map.landmarkCapacity(), 0);
   for (const RigCamera& c : rig.cameras) half_fov_.push_back(halfFieldOfView(c.model));
   candidates_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
   claim_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
-  visited_.assign(static_cast<std::size_t>(cams) * max_features_per_camera, 0);
+  best_.resize(max_features_per_camera);
+  gate_.resize(std::max(options.levels, 1));
   const int max_obs = 2 * cams;
   tri_obs_.resize(max_obs);
   tri_refs_.resize(max_obs);
@@ -57,12 +65,17 @@ LocalMapper::LocalMapper(const Rig& rig, const OdometryOptions& options, Map& ma
   outliers_.resize(static_cast<std::size_t>(cams) * max_features_per_camera * options.window_keyframes);
   if (options.backend) {
     solver_ = std::make_unique<backend::SlidingWindowSolver>(rig, windowCapacity(options, map, rig.size(), max_features_per_camera), solverOptions(options, monocular_));
+    if (options.backend_thread) worker_ = std::make_unique<BackendWorker>();
   }
 }
 
-LocalMapper::~LocalMapper() = default;
+LocalMapper::~LocalMapper() {
+  if (worker_) worker_->wait();  // the solver must outlive a solve in flight
+}
 
 void LocalMapper::reset() {
+  if (worker_) worker_->wait();
+  solving_ = false;  // the window is dropped with the map: its last result does not matter
   if (solver_) {
     // A fresh window (the old one's keyframes and landmarks are gone with the map). This allocates:
     // it happens only when tracking was lost, never per frame.
@@ -75,7 +88,10 @@ void LocalMapper::reset() {
   touched_count_ = 0;
 }
 
-Rig LocalMapper::refinedRig() const { return solver_ ? solver_->refinedRig() : rig_; }
+Rig LocalMapper::refinedRig() const {
+  if (worker_) worker_->wait();
+  return solver_ ? solver_->refinedRig() : rig_;
+}
 
 int LocalMapper::keyframeSlotOfId(int64_t id) const {
   for (int i = 0; i < map_.keyframeCapacity(); ++i) {
@@ -221,11 +237,10 @@ int LocalMapper::triangulateWithPrevious(int slot) {
 
   const int cams = rig_.size();
   const double min_depth = std::max(0.05, options_.new_points.min_depth);
-  constexpr double kMaxDepth = 200.0;
-  constexpr int kDepthSamples = 8;
   constexpr int kMaxHamming = 50;    // stricter than tracking: nothing else vouches for these matches
   constexpr float kRatio = 0.75f;
   constexpr double kEpipolarPx = 2.0;
+  constexpr int kMaxOctaveDifference = 2;
   int created = 0;
 
   for (int pi = 0; pi < np; ++pi) {
@@ -238,77 +253,67 @@ int LocalMapper::triangulateWithPrevious(int slot) {
       if (!kn.features.present[c2]) continue;
       const SE3 T_w_c2 = kn.T_w_b * rig_.T_b_c(c2);
       const FeatureSet& set2 = kn.features.sets[c2];
-      for (int a = 0; a < set2.count; ++a) {
-        if (kn.landmark_of[c2][a] >= 0 || !kn.features.valid[c2][a]) continue;
-        const Vec3 d2 = T_w_c2.R * kn.features.bearings[c2][a];
-        const int oa = set2.keypoints[a].octave;
-        int best = 257, second = 257, best_c1 = -1, best_b = -1;
-        for (int c1 = 0; c1 < cams; ++c1) {
-          if (!ko.features.present[c1]) continue;
-          const SE3 T_w_c1 = ko.T_w_b * rig_.T_b_c(c1);
-          const double axes = std::acos(std::clamp(T_w_c1.R.col(2).dot(T_w_c2.R.col(2)), -1.0, 1.0));
-          if (axes > half_fov_[c1] + half_fov_[c2]) continue;  // the two views cannot share a point
-          const Vec3 baseline = T_w_c2.t - T_w_c1.t;
-          Vec3 n = baseline.cross(d2);
-          if (n.norm() < 1e-9) continue;  // no baseline, or the ray runs along it
-          n.normalize();
-          const SE3 T_c1_w = T_w_c1.inverse();
-          const CameraModel& m1 = rig_.model(c1);
-          const double f1 = 0.5 * (m1.fx() + m1.fy());
-          const FeatureSet& set1 = ko.features.sets[c1];
-          ++stamp_;
-          auto consider = [&](int b) {
-            uint32_t& v = visited_[static_cast<std::size_t>(c1) * capacity_ + b];
-            if (v == stamp_) return;
-            v = stamp_;
-            if (ko.landmark_of[c1][b] >= 0 || !ko.features.valid[c1][b]) return;
-            const int ob = set1.keypoints[b].octave;
-            if (std::abs(ob - oa) > 2) return;
-            const Vec3 d1 = T_w_c1.R * ko.features.bearings[c1][b];
-            if (std::abs(n.dot(d1)) > kEpipolarPx * octave_scale_[ob] / f1) return;
-            const int d = hammingDistance(set2.descriptors[a], set1.descriptors[b]);
-            if (d < best) {
-              second = best;
-              best = d;
-              best_c1 = c1;
-              best_b = b;
-            } else if (d < second) {
-              second = d;
-            }
-          };
-          // Walk the epipolar curve of the ray over the depth range, cell by cell.
-          bool have_prev = false;
-          Vec2 prev;
-          for (int k = 0; k < kDepthSamples; ++k) {
-            const double inv = 1.0 / min_depth + (1.0 / kMaxDepth - 1.0 / min_depth) * k / (kDepthSamples - 1);
-            Vec2 uv;
-            if (!m1.project(T_c1_w * (T_w_c2.t + d2 / inv), uv) || !m1.inImage(uv, -40.0)) {
-              have_prev = false;
-              continue;
-            }
-            const Vec2 from = have_prev ? prev : uv;
-            const int steps = std::max(1, static_cast<int>((uv - from).norm() / 12.0));
-            for (int s = 0; s <= steps; ++s) {
-              const Vec2 q = from + (uv - from) * (static_cast<double>(s) / steps);
-              ko.grids[c1].forEachNear(q.x(), q.y(), 14.0, consider);
-            }
-            prev = uv;
-            have_prev = true;
-          }
+      std::fill(best_.begin(), best_.begin() + set2.count, Best{});
+      for (int c1 = 0; c1 < cams; ++c1) {
+        if (!ko.features.present[c1]) continue;
+        const SE3 T_w_c1 = ko.T_w_b * rig_.T_b_c(c1);
+        const double axes = std::acos(std::clamp(T_w_c1.R.col(2).dot(T_w_c2.R.col(2)), -1.0, 1.0));
+        if (axes > half_fov_[c1] + half_fov_[c2]) continue;  // the two views cannot share a point
+        const Vec3 baseline = T_w_c2.t - T_w_c1.t;
+        if (!band_index_.begin(baseline)) continue;  // no baseline: no depth from this pair
+        const FeatureSet& set1 = ko.features.sets[c1];
+        for (int b = 0; b < set1.count; ++b) {
+          if (ko.landmark_of[c1][b] >= 0 || !ko.features.valid[c1][b]) continue;
+          band_index_.add(b, T_w_c1.R * ko.features.bearings[c1][b], set1.keypoints[b].octave);
         }
-        if (best_b < 0 || best > kMaxHamming || !(best < kRatio * second)) continue;
+        band_index_.finish();
+        const CameraModel& m1 = rig_.model(c1);
+        const double f1 = 0.5 * (m1.fx() + m1.fy());
+        for (int o = 0; o < options_.levels; ++o) gate_[o] = kEpipolarPx * octave_scale_[o] / f1;
+
+        for (int a = 0; a < set2.count; ++a) {
+          if (kn.landmark_of[c2][a] >= 0 || !kn.features.valid[c2][a]) continue;
+          const Vec3 d2 = T_w_c2.R * kn.features.bearings[c2][a];
+          const int oa = set2.keypoints[a].octave;
+          Best& best = best_[a];
+          band_index_.forEachOnPlane(d2, oa - kMaxOctaveDifference, oa + kMaxOctaveDifference, gate_.data(),
+                                     [&](int32_t b, const float* d1f) {
+            // The two rays must meet in front of both cameras, at least the minimum depth along the new one.
+            const Vec3 d1(d1f[0], d1f[1], d1f[2]);
+            const double cosine = d2.dot(d1);
+            const double den = 1.0 - cosine * cosine;
+            if (den > 1e-12) {
+              const double along2 = d2.dot(baseline), along1 = d1.dot(baseline);
+              const double t2 = (cosine * along1 - along2) / den;
+              const double t1 = (along1 - cosine * along2) / den;
+              if (t2 < min_depth || t1 <= 0) return;
+            }
+            const int d = hammingDistance(set2.descriptors[a], set1.descriptors[b]);
+            if (d < best.distance) {
+              best.second = best.distance;
+              best.distance = d;
+              best.cam = c1;
+              best.kp = b;
+            } else if (d < best.second) {
+              best.second = d;
+            }
+          });
+        }
+      }
+      for (int a = 0; a < set2.count; ++a) {
+        const Best& best = best_[a];
+        if (best.kp < 0 || best.distance > kMaxHamming || !(best.distance < kRatio * best.second)) continue;
         // One candidate per old keypoint: the closest descriptor wins.
-        int32_t& claim = claim_[static_cast<std::size_t>(best_c1) * capacity_ + best_b];
+        int32_t& claim = claim_[static_cast<std::size_t>(best.cam) * capacity_ + best.kp];
         if (claim >= 0) {
-          if (candidates_[claim].distance <= best) continue;
+          if (candidates_[claim].distance <= best.distance) continue;
           candidates_[claim].distance = -1;  // beaten
         }
         claim = nc;
-        candidates_[nc++] = Candidate{static_cast<int16_t>(c2), static_cast<int16_t>(best_c1), a, best_b,
-                                      static_cast<int16_t>(best)};
+        candidates_[nc++] = Candidate{static_cast<int16_t>(c2), static_cast<int16_t>(best.cam), a, best.kp,
+                                      static_cast<int16_t>(best.distance)};
       }
     }
-
     // Triangulate every surviving candidate from all its rays: both keypoints and their multi-view partners.
     for (int i = 0; i < nc; ++i) {
       const Candidate& cand = candidates_[i];
@@ -353,7 +358,13 @@ int LocalMapper::triangulateWithPrevious(int slot) {
 }
 
 bool LocalMapper::optimize(int slot) {
+  if (!beginOptimize(slot)) return false;
+  return finishOptimize();
+}
+
+bool LocalMapper::beginOptimize(int slot) {
   if (!solver_) return false;
+  finishOptimize();  // one window at a time
   const auto start = std::chrono::steady_clock::now();
   Keyframe& kf = map_.keyframe(slot);
   if (solver_->isFull()) {
@@ -395,8 +406,21 @@ bool LocalMapper::optimize(int slot) {
       }
     }
   }
+  prepare_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  solving_ = true;
+  if (worker_) {
+    worker_->start(*solver_, options_.backend_iterations);
+  } else {
+    inline_summary_ = solver_->solve(options_.backend_iterations);
+  }
+  return true;
+}
 
-  const backend::SolveSummary summary = solver_->solve(options_.backend_iterations);
+bool LocalMapper::finishOptimize() {
+  if (!solving_) return false;
+  solving_ = false;
+  const auto start = std::chrono::steady_clock::now();
+  const backend::SolveSummary summary = worker_ ? worker_->wait() : inline_summary_;
   ++backend_solves_;
   // Outliers leave the back-end and the map (copied first: removing changes the solver's list).
   int no = 0;
@@ -427,8 +451,15 @@ bool LocalMapper::optimize(int slot) {
       if (l.in_backend) solver_->landmarkPosition(map_.liveLandmarkSlots()[i], l.p_w);
     }
   }
-  last_backend_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double apply_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  last_backend_ms_ = prepare_ms_ + (worker_ ? worker_->lastSolveMs() : 0.0) + apply_ms;
   return !summary.failed;
+}
+
+uint64_t LocalMapper::backendThreadAllocations() const {
+  if (!worker_) return 0;
+  worker_->wait();
+  return worker_->allocations();
 }
 
 int LocalMapper::cull(int newest_slot) {

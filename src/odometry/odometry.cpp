@@ -55,7 +55,10 @@ Odometry::~Odometry() = default;
 
 Rig Odometry::refinedRig() const { return mapper_->refinedRig(); }
 
+uint64_t Odometry::backendThreadAllocations() const { return mapper_->backendThreadAllocations(); }
+
 void Odometry::resetMap() {
+  pending_keyframe_ = -1;  // its window goes with the map
   map_.clear();
   mapper_->reset();
   initializer_->reset();
@@ -65,16 +68,18 @@ void Odometry::resetMap() {
 }
 
 void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
-  const auto start = Clock::now();
   timing_ = OdometryTiming{};
   ++stats_.frames;
   out = PoseEstimate{};
   out.t = frame.t;
   out.sequence = frame_index;
+  flush();  // the previous keyframe's solve, before this frame reads the map
+  const auto start = Clock::now();
+  const double flushed_ms = timing_.mapping_ms + timing_.backend_ms;
 
   if (!initialized_) {
     initialize(frame, frame_index, out);
-    timing_.tracking_ms = msSince(start) - timing_.mapping_ms - timing_.backend_ms;
+    timing_.tracking_ms = msSince(start) - (timing_.mapping_ms + timing_.backend_ms - flushed_ms);
     return;
   }
 
@@ -112,18 +117,19 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
       mapper_->triangulateWithPrevious(slot);
       timing_.mapping_ms = msSince(map_start);
       const auto be_start = Clock::now();
-      mapper_->optimize(slot);
+      if (mapper_->beginOptimize(slot)) pending_keyframe_ = slot;
       timing_.backend_ms = msSince(be_start);
-      const auto cull_start = Clock::now();
-      mapper_->cull(slot);
-      // The back-end moved this frame's pose: continue from there, with the same velocity.
-      T_w_last_ = map_.keyframe(slot).T_w_b;
       last_keyframe_frame_ = frame_index;
-      last_keyframe_pose_ = T_w_last_;
-      last_keyframe_tracked_ = countKeyframeLandmarks(slot);
+      last_keyframe_pose_ = T_w_b;
       ++stats_.keyframes;
       out.is_keyframe = true;
-      timing_.mapping_ms += msSince(cull_start);
+      if (pending_keyframe_ < 0) {
+        finishKeyframe(slot);  // no back-end: cull now
+      } else if (!options_.backend_thread) {
+        const auto finish_start = Clock::now();
+        finishPendingKeyframe();
+        timing_.backend_ms += msSince(finish_start);
+      }
     }
   }
   rememberTracked(frame, frame_index);
@@ -131,6 +137,36 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
   out.state = TrackingState::Tracking;
   out.valid = true;
   out.quality = static_cast<float>(std::min(1.0, inliers / std::max(1.0, 0.5 * last_keyframe_tracked_)));
+}
+
+void Odometry::flush() {
+  const auto start = Clock::now();
+  finishPendingKeyframe();
+  timing_.backend_ms += msSince(start);
+}
+
+void Odometry::finishPendingKeyframe() {
+  if (pending_keyframe_ < 0) return;
+  const int slot = pending_keyframe_;
+  pending_keyframe_ = -1;
+  mapper_->finishOptimize();
+  finishKeyframe(slot);
+}
+
+void Odometry::finishKeyframe(int slot) {
+  const auto cull_start = Clock::now();
+  mapper_->cull(slot);
+  // The back-end moved the keyframe's pose: continue from there, with the same velocity.
+  T_w_last_ = map_.keyframe(slot).T_w_b;
+  last_keyframe_pose_ = T_w_last_;
+  last_keyframe_tracked_ = countKeyframeLandmarks(slot);
+  // Landmarks the back-end or the culling erased are no longer tracked.
+  int kept = 0;
+  for (int i = 0; i < last_tracked_count_; ++i) {
+    if (map_.landmark(last_tracked_[i]).alive) last_tracked_[kept++] = last_tracked_[i];
+  }
+  last_tracked_count_ = kept;
+  timing_.mapping_ms += msSince(cull_start);
 }
 
 void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {

@@ -75,6 +75,7 @@ void readBackend(ConfigSection s, PipelineConfig& c) {
   OdometryOptions& o = c.odometry;
   s.read("enabled", o.backend);
   s.read("iterations", o.backend_iterations, 1, 100);
+  s.read("thread", o.backend_thread);
   s.read("refine_extrinsics", c.refine_extrinsics, {"auto", "on", "off"});
   s.read("extrinsic_sigma_translation", o.extrinsic_sigma_translation, 1e-6, 1.0);
   s.read("extrinsic_sigma_rotation_deg", o.extrinsic_sigma_rotation_deg, 1e-4, 45.0);
@@ -148,6 +149,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "  backend:\n"
      << "    enabled: " << (o.backend ? "true" : "false") << "\n"
      << "    iterations: " << o.backend_iterations << "\n"
+     << "    thread: " << (o.backend_thread ? "true" : "false") << "\n"
      << "    refine_extrinsics: " << c.refine_extrinsics << "\n"
      << "    extrinsic_sigma_translation: " << o.extrinsic_sigma_translation << "\n"
      << "    extrinsic_sigma_rotation_deg: " << o.extrinsic_sigma_rotation_deg << "\n";

@@ -148,6 +148,7 @@ int main(int argc, char** argv) {
       ms_avg = i == 0 ? timing.total_ms : 0.95 * ms_avg + 0.05 * timing.total_ms;
       if (show && (i % 5 == 0 || i + 1 == frames)) progress(i + 1, frames, ms_avg, pose);
     }
+    pipeline.flush();  // the last keyframe's back-end solve
     report.noteKeyframes(pipeline.odometry().map());
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     if (show) std::fprintf(stderr, "\n");

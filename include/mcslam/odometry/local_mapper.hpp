@@ -8,11 +8,14 @@
 
 #include "mcslam/features/octave_scales.hpp"
 #include "mcslam/backend/sliding_window_solver.hpp"
+#include "mcslam/odometry/epipolar_band_index.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/projection_search.hpp"
 
 namespace mcslam {
+
+class BackendWorker;
 
 class LocalMapper {
  public:
@@ -31,13 +34,25 @@ class LocalMapper {
   // Runs the sliding-window optimization including keyframe `slot` and writes the results back into
   // the map. Returns false when the back-end is off or failed.
   bool optimize(int slot);
+  // optimize() in two halves. beginOptimize() adds keyframe `slot` to the window and starts the solve (on the
+  // back-end thread when options.backend_thread); until finishOptimize() the map may be read and tracked
+  // against, but the back-end's landmarks may not be erased. finishOptimize() waits for the solve and applies
+  // it (outliers leave the map; poses and points are written back); it returns false when none was pending
+  // or it failed.
+  bool beginOptimize(int slot);
+  bool finishOptimize();
+  bool optimizing() const { return solving_; }
 
   // Erases landmarks that are rarely found where predicted, or that never got a second keyframe.
   int cull(int newest_slot);
 
   void reset();
   Rig refinedRig() const;
+  // Back-end milliseconds of the last keyframe: preparation, solve and applying it (the solve ran beside
+  // tracking when on its own thread).
   double lastBackendMs() const { return last_backend_ms_; }
+  // Heap allocations made by the back-end thread, all solves (0 without it): for the fixed-memory tests.
+  uint64_t backendThreadAllocations() const;
   uint64_t backendSolves() const { return backend_solves_; }
 
  private:
@@ -52,6 +67,10 @@ class LocalMapper {
   OdometryOptions options_;
   Map& map_;
   std::unique_ptr<backend::SlidingWindowSolver> solver_;
+  std::unique_ptr<BackendWorker> worker_;  // null: the solve runs inside beginOptimize()
+  bool solving_ = false;
+  backend::SolveSummary inline_summary_;
+  double prepare_ms_ = 0;
   std::vector<int32_t> touched_;
   std::vector<uint8_t> touched_flag_;
   int touched_count_ = 0;
@@ -64,8 +83,14 @@ class LocalMapper {
   };
   std::vector<Candidate> candidates_;
   std::vector<int32_t> claim_;       // per (camera, keypoint) of the old keyframe: best candidate index
-  std::vector<uint32_t> visited_;    // per keypoint of the old keyframe: stamp of the last visit
-  uint32_t stamp_ = 0;
+  struct Best {                      // per keypoint of the new keyframe's camera: its best old partner
+    int distance = 257, second = 257;
+    int cam = -1;
+    int32_t kp = -1;
+  };
+  std::vector<Best> best_;
+  EpipolarBandIndex band_index_;     // the old camera's free keypoints, by epipolar half-plane
+  std::vector<double> gate_;         // per octave: sine distance to the epipolar plane allowed
   std::vector<TriangulationObservation> tri_obs_;
   std::vector<KeypointRef> tri_refs_;  // keyframe-tagged refs in tri_obs_ order (cam, index)
   std::vector<int32_t> tri_kf_;        // keyframe slot of each tri_obs_ entry

@@ -49,6 +49,9 @@ class Odometry {
 
   // Estimates the pose of one rig frame whose features (and multi-view features) are computed.
   void process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
+  // Completes the back-end work of the last keyframe (process() does it first thing): call it after the last
+  // frame, before reading the map's final keyframes.
+  void flush();
 
   const OdometryStats& stats() const { return stats_; }
   const OdometryTiming& timing() const { return timing_; }
@@ -56,6 +59,8 @@ class Odometry {
   // The rig with the extrinsics the back-end refined (the calibration when refinement is off).
   Rig refinedRig() const;
   bool initialized() const { return initialized_; }
+  // Heap allocations made on the back-end thread so far (0 when the solve runs inline).
+  uint64_t backendThreadAllocations() const;
   // Frame index of the reference frame of the last initialization when it used two frames (the frames
   // between the two have no estimate of their own), -1 when it used one frame.
   int64_t lastInitializationReference() const { return last_init_reference_; }
@@ -69,6 +74,8 @@ class Odometry {
   int poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b);
   bool needKeyframe(const SE3& T_w_b, int inliers, uint64_t frame_index) const;
   int countKeyframeLandmarks(int slot) const;
+  void finishPendingKeyframe();  // waits for the back-end's solve of pending_keyframe_, then finishKeyframe()
+  void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
   void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
   int searchNewestKeyframeByDescriptor(const FrameFeatures& frame);
@@ -99,6 +106,7 @@ class Odometry {
   uint64_t last_keyframe_frame_ = 0;
   SE3 last_keyframe_pose_;
   int last_keyframe_tracked_ = 0;
+  int pending_keyframe_ = -1;     // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
   int64_t last_init_reference_ = -1;
   OdometryStats stats_;

@@ -49,6 +49,10 @@ struct OdometryOptions {
   // Back-end.
   bool backend = true;
   int backend_iterations = 6;
+  // The solve runs on a thread of its own while tracking goes on with the next frame; its result is applied
+  // before that frame touches the map, so the output does not depend on timing. A keyframe's own pose is then
+  // the tracked one (the optimized pose is what the following frames continue from).
+  bool backend_thread = true;
   bool refine_extrinsics = false;
   double extrinsic_sigma_translation = 0.02;  // metres
   double extrinsic_sigma_rotation_deg = 1.0;

@@ -24,6 +24,9 @@ class SlamPipeline final : public FrameProcessor {
   // track() runs. Each fills its part of `timing` (features_ms; tracking_ms and optimization_ms).
   void computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing);
   void track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out, PipelineTiming& timing);
+  // Completes the back-end work of the last keyframe (track() does it before the next frame): call it after
+  // the last frame, before reading the final map.
+  void flush() { odometry_.flush(); }
   // A FrameFeatures sized for this pipeline (allocates).
   FrameFeatures makeFrameFeatures() const { return FrameFeatures(rig_.size(), config_.orb.max_features); }
 
@@ -32,6 +35,7 @@ class SlamPipeline final : public FrameProcessor {
   const FrameFeatures& lastFeatures() const { return features_; }
   const FrontEnd& frontEnd() const { return front_end_; }
   const Odometry& odometry() const { return odometry_; }
+  Odometry& odometry() { return odometry_; }
   Rig refinedRig() const { return odometry_.refinedRig(); }
   // The back-end's current extrinsics (the calibration's when refinement is off).
   bool refinedRig(Rig& out) const override {
