@@ -31,15 +31,33 @@ bool SpacedSelector::farFromTaken(const Corner& c, const Corner* taken, float sp
   return true;
 }
 
+// Strongest first, the index breaking ties (so the order never depends on a sort's internals). FAST scores are
+// small integers: a counting sort over them is linear, and gives the order the comparison sort gives.
+void SpacedSelector::sortByScore(std::span<const Corner> corners) {
+  const int n = static_cast<int>(corners.size());
+  bool small_integers = true;
+  for (int i = 0; i < n && small_integers; ++i) {
+    const float s = corners[i].score;
+    small_integers = s >= 0.f && s < static_cast<float>(kScoreLevels) && s == std::floor(s);
+  }
+  if (!small_integers) {
+    for (int i = 0; i < n; ++i) order_[static_cast<size_t>(i)] = i;
+    std::sort(order_.begin(), order_.begin() + n, [&](int a, int b) {
+      return corners[a].score != corners[b].score ? corners[a].score > corners[b].score : a < b;
+    });
+    return;
+  }
+  int start[kScoreLevels + 1] = {};
+  for (int i = 0; i < n; ++i) ++start[kScoreLevels - static_cast<int>(corners[i].score)];  // descending
+  for (int k = 0; k < kScoreLevels; ++k) start[k + 1] += start[k];
+  for (int i = 0; i < n; ++i) order_[static_cast<size_t>(start[kScoreLevels - 1 - static_cast<int>(corners[i].score)]++)] = i;
+}
+
 int SpacedSelector::select(std::span<const Corner> corners, const Rect& region, float spacing, int budget,
                            Corner* out) {
   const int n = static_cast<int>(corners.size());
   if (budget <= 0 || n == 0 || n > static_cast<int>(order_.size())) return 0;
-  for (int i = 0; i < n; ++i) order_[static_cast<size_t>(i)] = i;
-  // Index breaks ties, so the order never depends on the sort's internals.
-  std::sort(order_.begin(), order_.begin() + n, [&](int a, int b) {
-    return corners[a].score != corners[b].score ? corners[a].score > corners[b].score : a < b;
-  });
+  sortByScore(corners);
   std::fill(used_.begin(), used_.begin() + n, 0);
   origin_x_ = region.x0;
   origin_y_ = region.y0;

@@ -24,6 +24,8 @@ class SpacedSelector {
 
  private:
   bool farFromTaken(const Corner& c, const Corner* taken, float spacing) const;
+  void sortByScore(std::span<const Corner> corners);  // into order_
+  static constexpr int kScoreLevels = 256;  // integer scores below this take the counting sort
 
   int max_width_, max_height_;
   std::vector<int> order_;           // corner indices, strongest first
