@@ -44,8 +44,30 @@ bool FrameMatches::offer(int cam, int kp, int lm, int distance) {
   return true;
 }
 
+namespace {
+
+// Widest angle from the optical axis over the image border (where it is largest for any lens whose radial
+// mapping grows outwards), plus a degree; pi when a border pixel has no bearing (then no cone is assumed).
+double fieldHalfAngle(const CameraModel& m) {
+  constexpr int kStep = 4;
+  double widest = 0;
+  auto visit = [&](double x, double y) {
+    Vec3 b;
+    widest = m.unproject(Vec2(x, y), b) ? std::max(widest, std::acos(std::clamp(b.z(), -1.0, 1.0))) : M_PI;
+  };
+  for (int x = 0; x < m.width(); x += kStep) visit(x, 0), visit(x, m.height() - 1);
+  for (int y = 0; y < m.height(); y += kStep) visit(0, y), visit(m.width() - 1, y);
+  visit(m.width() - 1, m.height() - 1);
+  return std::min(M_PI, widest + M_PI / 180.0);
+}
+
+}  // namespace
+
 ProjectionSearch::ProjectionSearch(const Rig& rig, int max_features_per_camera) : rig_(rig), T_c_w_(rig.size()) {
-  for (const RigCamera& c : rig.cameras) grids_.emplace_back(c.model.width(), c.model.height(), 24, max_features_per_camera);
+  for (const RigCamera& c : rig.cameras) {
+    grids_.emplace_back(c.model.width(), c.model.height(), 24, max_features_per_camera);
+    cos_field_.push_back(std::cos(fieldHalfAngle(c.model)));
+  }
 }
 
 void ProjectionSearch::prepare(const FrameFeatures& frame) {
@@ -67,6 +89,7 @@ int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T
     for (int c = 0; c < cams; ++c) {
       if (!frame.present[c] || matches.keypointOf(lm, c) >= 0) continue;
       const Vec3 p_c = T_c_w_[c] * l.p_w;
+      if (p_c.z() < cos_field_[c] * p_c.norm()) continue;  // outside the camera's field of view
       Vec2 uv;
       const CameraModel& model = rig_.model(c);
       if (!model.project(p_c, uv) || !model.inImage(uv, 2.0)) continue;

@@ -63,6 +63,9 @@ class ProjectionSearch {
   const Rig& rig_;
   std::vector<KeypointGrid> grids_;
   std::vector<SE3> T_c_w_;
+  // Per camera: cosine of the widest angle from the optical axis that any pixel of the image sees, with a
+  // margin. A point outside that cone cannot project into the image: it is skipped before the lens model.
+  std::vector<double> cos_field_;
 };
 
 }  // namespace mcslam
