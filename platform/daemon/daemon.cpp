@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 
@@ -63,6 +64,7 @@ Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> proce
                  static_cast<int64_t>(config.assembly.timeout_ms * kMs)),
       rig_ring_(config.capacities.rig_ring_slots, [this](RigFrame& f) { f.allocate(sizes_); }),
       pose_ring_(config.capacities.pose_ring_slots), views_(sizes_.size()), udp_(destinationsOf(config)) {
+  staged_.resize(static_cast<std::size_t>(std::max(processor_->stageSlots(), 0)));
   if (config.publish.shm_enabled)
     shm_ = std::make_unique<PoseShmWriter>(config.publish.shm_name, config.publish.shm_ring_length,
                                            config.publish.shm_mode);
@@ -90,6 +92,7 @@ void Daemon::start() {
   started_ = true;
   publishing_thread_ = std::thread([this] { publishingLoop(); });
   processing_thread_ = std::thread([this] { processingLoop(); });
+  if (!staged_.empty()) features_thread_ = std::thread([this] { featuresLoop(); });
   assembly_thread_ = std::thread([this] { assemblyLoop(); });
   source_->start(camera_rings_, trigger_log_);
   if (trigger_thread_) trigger_thread_->start();
@@ -111,8 +114,13 @@ bool Daemon::stop(int64_t grace_ns) {
     clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
   }
   const bool processing_finished = processing_done_.load(std::memory_order_acquire);
+  // The tracking stage ends after the features stage: both are done, or both are left behind.
   if (processing_finished) processing_thread_.join();
   else processing_thread_.detach();  // stuck inside the pipeline; we still save what was published
+  if (features_thread_.joinable()) {
+    if (processing_finished) features_thread_.join();
+    else features_thread_.detach();
+  }
   stop_publishing_ = true;
   pose_bell_.ring();
   publishing_thread_.join();
@@ -178,8 +186,13 @@ void Daemon::processingLoop() {
   nameThisThread("mcslam-process");
   if (const auto why = setRealtimePriority(config_.realtime.processing_priority); !why.empty())
     spdlog::warn("processing thread: {}", why);
+  if (staged_.empty()) wholeFrameLoop();
+  else trackingLoop();
+  processing_done_.store(true, std::memory_order_release);
+}
+
+void Daemon::wholeFrameLoop() {
   const int cameras = static_cast<int>(sizes_.size());
-  const uint64_t warmup = static_cast<uint64_t>(config_.warmup_frames);
   for (;;) {
     const uint32_t ticket = rig_bell_.ticket();
     RigFrame* f = rig_ring_.acquire();
@@ -195,18 +208,80 @@ void Daemon::processingLoop() {
     out.trigger_mono_ns = f->trigger_mono_ns;
     out.cameras_present = f->presentCount();
     rig_ring_.release();
-    if (pose_ring_.publish()) pose_drops_.fetch_add(1, std::memory_order_relaxed);
-    pose_bell_.ring();
-    tracking_.store(static_cast<uint8_t>(out.estimate.state), std::memory_order_relaxed);
-    const uint64_t done = processed_.fetch_add(1, std::memory_order_release) + 1;
-    if (!warm_.load(std::memory_order_relaxed) && done >= warmup) {
-      processed_at_warmup_.store(done, std::memory_order_relaxed);
-      warm_.store(true, std::memory_order_release);
-      source_->endWarmup();
-    }
-    processing_meter_.note(warm_.load(std::memory_order_relaxed));
+    handOver(out);
   }
-  processing_done_.store(true, std::memory_order_release);
+}
+
+void Daemon::featuresLoop() {
+  nameThisThread("mcslam-features");
+  if (const auto why = setRealtimePriority(config_.realtime.processing_priority); !why.empty())
+    spdlog::warn("features thread: {}", why);
+  const int cameras = static_cast<int>(sizes_.size());
+  const uint64_t slots = staged_.size();
+  for (;;) {
+    const uint32_t ticket = rig_bell_.ticket();
+    RigFrame* f = rig_ring_.acquire();
+    if (!f) {
+      if (stop_processing_.load(std::memory_order_relaxed)) break;
+      rig_bell_.wait(ticket, 50 * kMs);
+      continue;
+    }
+    // A free slot (tracking finishes them in order); meanwhile new rig frames queue, and the oldest is
+    // dropped when the rig ring is full, as without stages.
+    for (;;) {
+      const uint32_t free_ticket = stage_free_bell_.ticket();
+      if (staged_head_.load(std::memory_order_relaxed) - staged_tail_.load(std::memory_order_acquire) < slots) break;
+      stage_free_bell_.wait(free_ticket, 50 * kMs);
+    }
+    const uint64_t head = staged_head_.load(std::memory_order_relaxed);
+    const int slot = static_cast<int>(head % slots);
+    for (int c = 0; c < cameras; ++c) views_[c] = f->images[c].view();
+    const RigFrameView view{f->capture_ns, f->sequence, cameras, views_.data(), f->present.get()};
+    processor_->prepare(view, slot);
+    staged_[static_cast<std::size_t>(slot)] = StagedFrame{f->trigger_mono_ns, f->presentCount()};
+    rig_ring_.release();
+    staged_head_.store(head + 1, std::memory_order_release);
+    staged_bell_.ring();
+    features_meter_.note(warm_.load(std::memory_order_relaxed));
+  }
+  features_done_.store(true, std::memory_order_release);
+  staged_bell_.ring();
+}
+
+void Daemon::trackingLoop() {
+  const uint64_t slots = staged_.size();
+  for (;;) {
+    const uint32_t ticket = staged_bell_.ticket();
+    const uint64_t tail = staged_tail_.load(std::memory_order_relaxed);
+    if (staged_head_.load(std::memory_order_acquire) == tail) {
+      // features_done_ is set after the last prepared frame: read it first, then look again.
+      if (features_done_.load(std::memory_order_acquire) && staged_head_.load(std::memory_order_acquire) == tail) break;
+      staged_bell_.wait(ticket, 50 * kMs);
+      continue;
+    }
+    const int slot = static_cast<int>(tail % slots);
+    PoseSlot& out = pose_ring_.writeSlot();
+    processor_->finish(slot, out.estimate);
+    out.trigger_mono_ns = staged_[static_cast<std::size_t>(slot)].trigger_mono_ns;
+    out.cameras_present = staged_[static_cast<std::size_t>(slot)].cameras_present;
+    staged_tail_.store(tail + 1, std::memory_order_release);
+    stage_free_bell_.ring();
+    handOver(out);
+  }
+}
+
+void Daemon::handOver(PoseSlot& out) {
+  const uint64_t warmup = static_cast<uint64_t>(config_.warmup_frames);
+  if (pose_ring_.publish()) pose_drops_.fetch_add(1, std::memory_order_relaxed);
+  pose_bell_.ring();
+  tracking_.store(static_cast<uint8_t>(out.estimate.state), std::memory_order_relaxed);
+  const uint64_t done = processed_.fetch_add(1, std::memory_order_release) + 1;
+  if (!warm_.load(std::memory_order_relaxed) && done >= warmup) {
+    processed_at_warmup_.store(done, std::memory_order_relaxed);
+    warm_.store(true, std::memory_order_release);
+    source_->endWarmup();
+  }
+  processing_meter_.note(warm_.load(std::memory_order_relaxed));
 }
 
 void Daemon::publishPose(const PoseSlot& slot) {
@@ -252,6 +327,7 @@ void Daemon::publishingLoop() {
 bool Daemon::drained() const {
   if (!source_->finished() || assembler_.pendingFrames() != 0 || rig_ring_.size() != 0 || pose_ring_.size() != 0)
     return false;
+  if (staged_head_.load() != staged_tail_.load()) return false;
   for (int c = 0; c < camera_rings_.cameras(); ++c)
     if (camera_rings_.ring(c).size() != 0) return false;
   return true;
@@ -287,8 +363,8 @@ DaemonStats Daemon::stats() const {
   s.warm = warm_.load();
   if (s.warm) {
     s.frames_after_warmup = s.processed - processed_at_warmup_.load();
-    s.allocations_after_warmup = assembly_meter_.since() + processing_meter_.since() + publishing_meter_.since() +
-                                 source_->allocationsSinceWarmup();
+    s.allocations_after_warmup = assembly_meter_.since() + features_meter_.since() + processing_meter_.since() +
+                                 publishing_meter_.since() + source_->allocationsSinceWarmup();
   }
   s.source_finished = source_->finished();
   return s;

@@ -1,6 +1,8 @@
 #pragma once
 // mcslamd's machinery: trigger -> acquisition (source) -> per-camera rings -> rig assembly -> rig ring
 // -> processing (FrameProcessor) -> pose ring -> publishing (shared memory, UDP, trajectory file).
+// A processor with stages (the SLAM pipeline) is run on two threads: the front-end of the next rig frame
+// while the current one is tracked.
 //
 // Everything (devices, rings, segment, files) is opened and sized in the constructor, which throws
 // InputError naming the config key before any thread starts. After warm-up no thread allocates.
@@ -72,6 +74,10 @@ class Daemon {
  private:
   void assemblyLoop();
   void processingLoop();
+  void wholeFrameLoop();  // processing for a processor without stages: process() per rig frame
+  void featuresLoop();    // stage one (prepare) on its own thread, when the processor has stages
+  void trackingLoop();    // stage two (finish) on the processing thread
+  void handOver(PoseSlot& out);  // a processed frame's pose to the publisher, warm-up bookkeeping
   void publishingLoop();
   bool emitRigFrame(int64_t now, bool force);
   void publishPose(const PoseSlot& slot);
@@ -102,7 +108,18 @@ class Daemon {
   std::unique_ptr<PulseTrigger> pulse_;
   std::unique_ptr<TriggerThread> trigger_thread_;
 
-  std::thread assembly_thread_, processing_thread_, publishing_thread_;
+  // Frames between the two processing stages: the processor holds them in its slots, used in order;
+  // staged_head_ counts the prepared ones, staged_tail_ the finished ones.
+  struct StagedFrame {
+    int64_t trigger_mono_ns = 0;
+    int cameras_present = 0;
+  };
+  std::vector<StagedFrame> staged_;
+  std::atomic<uint64_t> staged_head_{0}, staged_tail_{0};
+  std::atomic<bool> features_done_{false};
+  Doorbell staged_bell_, stage_free_bell_;
+
+  std::thread assembly_thread_, features_thread_, processing_thread_, publishing_thread_;
   std::atomic<bool> stop_assembly_{false}, stop_processing_{false}, stop_publishing_{false};
   std::atomic<bool> processing_done_{false};
   bool started_ = false, stopped_ = false;
@@ -112,7 +129,7 @@ class Daemon {
   std::atomic<bool> warm_{false};
   std::atomic<uint64_t> processed_at_warmup_{0};
   LatencyHistogram latency_;
-  ThreadAllocMeter assembly_meter_, processing_meter_, publishing_meter_;
+  ThreadAllocMeter assembly_meter_, features_meter_, processing_meter_, publishing_meter_;
   uint64_t sequence_ = 0;  // publisher only
 };
 

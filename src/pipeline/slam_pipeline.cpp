@@ -29,7 +29,10 @@ SlamPipeline::SlamPipeline(const Rig& rig, const PipelineConfig& config)
       config_(config),
       front_end_(rig_, config_),
       odometry_(rig_, effectiveOdometryOptions(config_, front_end_.overlap()), config_.orb.max_features),
-      features_(rig_.size(), config_.orb.max_features) {}
+      features_(rig_.size(), config_.orb.max_features) {
+  // Two: one being prepared while the other is finished.
+  for (int k = 0; k < 2; ++k) stages_.push_back(Stage{FrameFeatures(rig_.size(), config_.orb.max_features), 0, 0, {}});
+}
 
 void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing) {
   front_end_.compute(frame, out);
@@ -44,6 +47,24 @@ void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Times
   const OdometryTiming& o = odometry_.timing();
   timing.tracking_ms = o.tracking_ms + o.mapping_ms;
   timing.optimization_ms = o.backend_ms;
+}
+
+void SlamPipeline::prepare(const RigFrameView& frame, int slot) {
+  Stage& s = stages_[static_cast<std::size_t>(slot)];
+  const auto start = std::chrono::steady_clock::now();
+  s.timing = PipelineTiming{};
+  computeFeatures(frame, s.features, s.timing);
+  s.sequence = frame.sequence;
+  s.t = frame.t;
+  s.timing.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void SlamPipeline::finish(int slot, PoseEstimate& out) {
+  Stage& s = stages_[static_cast<std::size_t>(slot)];
+  const auto start = std::chrono::steady_clock::now();
+  track(s.features, s.sequence, s.t, out, s.timing);
+  s.timing.total_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  timing_ = s.timing;
 }
 
 void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {

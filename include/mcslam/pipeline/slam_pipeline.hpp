@@ -1,5 +1,7 @@
 #pragma once
 // The whole SLAM pipeline behind the FrameProcessor boundary: front-end, odometry and back-end.
+#include <vector>
+
 #include "mcslam/odometry/odometry.hpp"
 #include "mcslam/pipeline/front_end.hpp"
 
@@ -18,6 +20,10 @@ class SlamPipeline final : public FrameProcessor {
   SlamPipeline(const Rig& rig, const PipelineConfig& config);
 
   void process(const RigFrameView& frame, PoseEstimate& out) override;
+  // The front-end in prepare(), the odometry in finish() (FrameProcessor's stages).
+  int stageSlots() const override { return static_cast<int>(stages_.size()); }
+  void prepare(const RigFrameView& frame, int slot) override;
+  void finish(int slot, PoseEstimate& out) override;
 
   // The two stages of process(), for a caller that overlaps the front-end of the next frame with the odometry
   // of this one (mcslam-run): computeFeatures() may run on another thread, into another FrameFeatures, while
@@ -51,6 +57,13 @@ class SlamPipeline final : public FrameProcessor {
   Odometry odometry_;
   FrameFeatures features_;
   PipelineTiming timing_;
+  struct Stage {
+    FrameFeatures features;
+    uint64_t sequence = 0;
+    Timestamp t = 0;
+    PipelineTiming timing;
+  };
+  std::vector<Stage> stages_;  // prepared frames waiting for finish()
 };
 
 // Resolves `refine_extrinsics: auto` for the rig and overlap.
