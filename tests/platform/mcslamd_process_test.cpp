@@ -307,7 +307,7 @@ TEST(McslamdProcess, ImageCodecIsMappedOnlyWhenTheReplayMeetsAPng) {
     ASSERT_TRUE(notify.ok());
     const std::string config = test::writeFile(dir.file(data + ".yaml"),
         "status_interval_s: 0.1\nsource:\n  type: dataset\n  dataset:\n    path: " + data +
-        "\n    rate: fastest\n    at_end: loop\npublish:\n  shm:\n    enabled: false\noutput:\n  directory: out_" + data + "\n");
+        "\n    rate: fastest\n    at_end: loop\npublish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
     const std::string log = dir.file(data + ".log");
     const pid_t pid = spawnDaemon(config, dir.file(data + ".sock"), "400000", log);
     // WATCHDOG=1 is sent only once frames are processed: their images were read by then.
