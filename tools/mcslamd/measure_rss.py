@@ -87,6 +87,9 @@ def breakdown(pid, top=12):
     lib_kb = sum(v for k, v in by_name.items() if k in libs)
     print("  %d shared libraries mapped, %.1f MB resident (text, data and their relocated pages)"
           % (len(libs), lib_kb / 1024.0))
+    # Loaded only when the replay meets a PNG or JPEG (the image codec module; binary PGM needs none).
+    codec = sorted(os.path.basename(l) for l in libs if "imgcodecs" in l or "mcslam_image_codec" in l)
+    print("  image codec: %s" % (", ".join(codec) if codec else "not mapped"))
     for k, v in sorted(by_name.items(), key=lambda kv: -kv[1])[:top]:
         print("  %8.1f MB  %s" % (v / 1024.0, k))
 
