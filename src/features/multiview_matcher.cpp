@@ -115,10 +115,12 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
   members_.resize(parent_.size());
   distance_count_.resize(258);
   scratch_obs_.resize(n);
+  members_obs_.resize(n);
 }
 
-void MultiViewMatcher::compute(FrameFeatures& f) {
+void MultiViewMatcher::compute(FrameFeatures& f, const ImageView* images) {
   stats_ = MultiViewStats{};
+  images_ = options_.align_subpixel ? images : nullptr;
   f.mv_count = 0;
   f.mv_ref_count = 0;
   computeBearings(f);
@@ -129,44 +131,48 @@ void MultiViewMatcher::compute(FrameFeatures& f) {
   }
   stats_.pair_matches = match_count_;
   mergeTracks(f);
+  images_ = nullptr;
+}
+
+// A keypoint's bearing: interpolated on the camera's grid and polished by one Gauss-Newton step on the
+// projection (the smallest bearing change that moves its projection onto the pixel); the model's iterative
+// unprojection where the grid has no bearing.
+bool MultiViewMatcher::bearingOf(int cam, const Vec2& uv, Vec3& bearing) const {
+  const CameraModel& model = rig_.model(cam);
+  const std::vector<Vec3>& grid = bearing_grid_[cam];
+  const int cols = bearing_grid_cols_[cam], rows = static_cast<int>(grid.size()) / cols;
+  const double gxf = uv.x() / kBearingGridStep, gyf = uv.y() / kBearingGridStep;
+  const int gx = static_cast<int>(std::floor(gxf)), gy = static_cast<int>(std::floor(gyf));
+  if (gx >= 0 && gy >= 0 && gx + 1 < cols && gy + 1 < rows) {
+    const Vec3& b00 = grid[gy * cols + gx];
+    const Vec3& b10 = grid[gy * cols + gx + 1];
+    const Vec3& b01 = grid[(gy + 1) * cols + gx];
+    const Vec3& b11 = grid[(gy + 1) * cols + gx + 1];
+    if (b00.squaredNorm() > 0 && b10.squaredNorm() > 0 && b01.squaredNorm() > 0 && b11.squaredNorm() > 0) {
+      const double ax = gxf - gx, ay = gyf - gy;
+      Vec3 b = ((1 - ax) * (1 - ay)) * b00 + (ax * (1 - ay)) * b10 + ((1 - ax) * ay) * b01 + (ax * ay) * b11;
+      b.normalize();
+      Vec2 proj;
+      Mat23 J;
+      if (model.project(b, proj, &J)) {
+        const Mat2 JJt = J * J.transpose();
+        const Vec3 delta = J.transpose() * JJt.inverse() * (uv - proj);
+        if (delta.allFinite() && delta.norm() < 1e-2) {
+          bearing = (b + delta).normalized();
+          return true;
+        }
+      }
+    }
+  }
+  return model.unproject(uv, bearing);
 }
 
 void MultiViewMatcher::computeBearings(FrameFeatures& f) {
   for (int c = 0; c < f.cameras(); ++c) {
-    const CameraModel& model = rig_.model(c);
     const Mat3 R_b_c = rig_.T_b_c(c).R;
     const FeatureSet& s = f.sets[c];
-    const std::vector<Vec3>& grid = bearing_grid_[c];
-    const int cols = bearing_grid_cols_[c], rows = static_cast<int>(grid.size()) / cols;
     for (int k = 0; k < s.count; ++k) {
-      const Vec2 uv(s.keypoints[k].x, s.keypoints[k].y);
-      Vec3& bearing = f.bearings[c][k];
-      bool ok = false;
-      const double gxf = uv.x() / kBearingGridStep, gyf = uv.y() / kBearingGridStep;
-      const int gx = static_cast<int>(std::floor(gxf)), gy = static_cast<int>(std::floor(gyf));
-      if (gx >= 0 && gy >= 0 && gx + 1 < cols && gy + 1 < rows) {
-        const Vec3& b00 = grid[gy * cols + gx];
-        const Vec3& b10 = grid[gy * cols + gx + 1];
-        const Vec3& b01 = grid[(gy + 1) * cols + gx];
-        const Vec3& b11 = grid[(gy + 1) * cols + gx + 1];
-        if (b00.squaredNorm() > 0 && b10.squaredNorm() > 0 && b01.squaredNorm() > 0 && b11.squaredNorm() > 0) {
-          const double ax = gxf - gx, ay = gyf - gy;
-          Vec3 b = ((1 - ax) * (1 - ay)) * b00 + (ax * (1 - ay)) * b10 + ((1 - ax) * ay) * b01 + (ax * ay) * b11;
-          b.normalize();
-          // One Gauss-Newton step: the smallest bearing change that moves its projection onto the keypoint.
-          Vec2 proj;
-          Mat23 J;
-          if (model.project(b, proj, &J)) {
-            const Mat2 JJt = J * J.transpose();
-            const Vec3 delta = J.transpose() * JJt.inverse() * (uv - proj);
-            if (delta.allFinite() && delta.norm() < 1e-2) {
-              bearing = (b + delta).normalized();
-              ok = true;
-            }
-          }
-        }
-      }
-      if (!ok) ok = model.unproject(uv, bearing);
+      const bool ok = bearingOf(c, Vec2(s.keypoints[k].x, s.keypoints[k].y), f.bearings[c][k]);
       f.valid[c][k] = ok ? 1 : 0;
       f.mv_of[c][k] = -1;
       dir_b_[c][k] = R_b_c * f.bearings[c][k];
@@ -470,17 +476,123 @@ void MultiViewMatcher::mergeTracks(FrameFeatures& f) {
   }
 }
 
+void MultiViewMatcher::swapMembers(FrameFeatures& f, int first, int a, int b) {
+  std::swap(f.mv_refs[first + a], f.mv_refs[first + b]);
+  std::swap(members_obs_[a], members_obs_[b]);
+}
+
+// The partner's keypoint aligned to what the reference keypoint (member 0) shows: the epipolar curve of the
+// reference pixel in the partner camera is Y(rho) = rho * b + m in that camera's frame (rho: inverse range
+// along the reference ray; rho = 0 is the point at infinity), the start is the partner keypoint projected onto
+// it, and the patch warp is the derivative of the reference pixel -> partner pixel map there.
+AlignmentStatus MultiViewMatcher::alignPartner(const FrameFeatures& f, int first, int s) {
+  const KeypointRef& r = f.mv_refs[first];
+  const KeypointRef& p = f.mv_refs[first + s];
+  const ImageView& ref_image = images_[r.cam];
+  const ImageView& image = images_[p.cam];
+  if (ref_image.empty() || image.empty()) return AlignmentStatus::NotRefinable;
+  const SE3& T_b_r = rig_.T_b_c(r.cam);
+  const SE3& T_b_p = rig_.T_b_c(p.cam);
+  const CameraModel& model_r = rig_.model(r.cam);
+  const CameraModel& model_p = rig_.model(p.cam);
+  const Vec3& bearing_r = f.bearings[r.cam][r.index];
+  const Mat3 R_p_b = T_b_p.R.transpose();
+  const Vec3 b = R_p_b * (T_b_r.t - T_b_p.t);
+  const Vec3 m = R_p_b * (T_b_r.R * bearing_r);
+
+  // Start: the inverse range where the two rays pass closest, then Gauss-Newton onto the partner keypoint.
+  const Keypoint& kp = f.sets[p.cam].keypoints[p.index];
+  const Vec2 uv_kp(kp.x, kp.y);
+  const Vec3& bearing_p = f.bearings[p.cam][p.index];
+  const double cos_rays = m.dot(bearing_p);
+  const Vec3 w0 = -b;  // partner centre minus reference centre, partner frame
+  double rho = 0;
+  if (1 - cos_rays * cos_rays > 1e-12) {
+    const double range = (-w0.dot(m) + cos_rays * w0.dot(bearing_p)) / (1 - cos_rays * cos_rays);
+    if (range > options_.triangulation.min_depth) rho = 1.0 / range;
+  }
+  Vec2 uv;
+  Mat23 J;
+  Vec2 g = Vec2::Zero();
+  for (int it = 0; it < 3; ++it) {
+    if (!model_p.project(rho * b + m, uv, &J)) return AlignmentStatus::NotRefinable;
+    g = J * b;
+    const double gg = g.squaredNorm();
+    if (!(gg > 1e-12)) return AlignmentStatus::NotRefinable;  // the reference ray runs along the baseline
+    rho = std::max(0.0, rho + g.dot(uv_kp - uv) / gg);
+  }
+  if (!model_p.project(rho * b + m, uv, &J)) return AlignmentStatus::NotRefinable;
+  g = J * b;
+  if (!(g.squaredNorm() > 1e-12)) return AlignmentStatus::NotRefinable;
+  // Patch warp: a reference pixel offset moves the point normal to the reference ray (pseudo-inverse of the
+  // reference projection's Jacobian at the unit bearing; the range cancels against the partner's Jacobian at Y).
+  Vec2 uv_r;
+  Mat23 J_r;
+  if (!model_r.project(bearing_r, uv_r, &J_r)) return AlignmentStatus::NotRefinable;
+  const Eigen::Matrix<double, 3, 2> J_r_pinv = J_r.transpose() * (J_r * J_r.transpose()).inverse();
+  const Mat2 A = J * (R_p_b * T_b_r.R) * J_r_pinv;
+  const Keypoint& kr = f.sets[r.cam].keypoints[r.index];
+  const EpipolarAlignment a = alignAlongEpipolar(ref_image, Vec2(kr.x, kr.y), image, uv, g.normalized(), A,
+                                                 sigma_[kr.octave], sigma_[kp.octave], options_.alignment);
+  if (a.ok()) {
+    Member& member = members_obs_[s];
+    Vec3 bearing;
+    if (!bearingOf(p.cam, a.uv, bearing)) return AlignmentStatus::NotRefinable;
+    member.uv = a.uv;
+    member.bearing = bearing;
+    member.sigma_px = a.sigma_px;
+    member.aligned = true;
+  }
+  return a.status;
+}
+
+// Aligns every partner to the reference (the finest keypoint, moved to member 0); partners whose patches
+// disagree leave the track. Returns the new size. An aligned track's rays all pass through the scene point of
+// the reference pixel: that pixel defines the point, so the reference keeps only the alignment's floor sigma.
+int MultiViewMatcher::alignToReference(FrameFeatures& f, int first, int size) {
+  int ref = 0;
+  for (int s = 1; s < size; ++s) {
+    const KeypointRef& a = f.mv_refs[first + s];
+    const KeypointRef& b = f.mv_refs[first + ref];
+    if (f.sets[a.cam].keypoints[a.index].octave < f.sets[b.cam].keypoints[b.index].octave) ref = s;
+  }
+  swapMembers(f, first, 0, ref);
+  bool any = false;
+  for (int s = 1; s < size;) {
+    const AlignmentStatus status = alignPartner(f, first, s);
+    if (status == AlignmentStatus::Disagrees) {
+      ++stats_.disagreeing;
+      swapMembers(f, first, s, size - 1);
+      --size;
+      continue;
+    }
+    any = any || status == AlignmentStatus::Ok;
+    stats_.aligned += status == AlignmentStatus::Ok ? 1 : 0;
+    ++s;
+  }
+  if (any) {
+    const KeypointRef& r = f.mv_refs[first];
+    members_obs_[0].sigma_px = options_.alignment.sigma_floor_spacings * sigma_[f.sets[r.cam].keypoints[r.index].octave];
+  }
+  return size;
+}
+
 void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
+  for (int s = 0; s < size; ++s) {
+    const KeypointRef& r = f.mv_refs[first + s];
+    const Keypoint& kp = f.sets[r.cam].keypoints[r.index];
+    members_obs_[s] = Member{Vec2(kp.x, kp.y), f.bearings[r.cam][r.index], sigma_[kp.octave], false};
+  }
+  if (images_ != nullptr) size = alignToReference(f, first, size);
   auto fillObservations = [&](int n) {
     for (int s = 0; s < n; ++s) {
       const KeypointRef& r = f.mv_refs[first + s];
-      const Keypoint& kp = f.sets[r.cam].keypoints[r.index];
       TriangulationObservation& o = scratch_obs_[s];
       o.model = &rig_.model(r.cam);
       o.T_f_c = rig_.T_b_c(r.cam);
-      o.uv = Vec2(kp.x, kp.y);
-      o.bearing = f.bearings[r.cam][r.index];
-      o.sigma_px = sigma_[std::clamp<int>(kp.octave, 0, kMaxOctaves - 1)];
+      o.uv = members_obs_[s].uv;
+      o.bearing = members_obs_[s].bearing;
+      o.sigma_px = members_obs_[s].sigma_px;
     }
   };
   TriangulationResult tri;
@@ -500,7 +612,7 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
         worst = s;
       }
     }
-    std::swap(f.mv_refs[first + worst], f.mv_refs[first + size - 1]);
+    swapMembers(f, first, worst, size - 1);
     --size;
   }
   bool keep = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain ||
@@ -533,6 +645,15 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
   if (!keep) {
     ++stats_.dropped;
     return;  // its keypoints stay mono features
+  }
+  // Aligned partners keep their aligned position: the odometry observes the point where the track saw it.
+  for (int s = 0; s < size; ++s) {
+    if (!members_obs_[s].aligned) continue;
+    const KeypointRef& r = f.mv_refs[first + s];
+    Keypoint& kp = f.sets[r.cam].keypoints[r.index];
+    kp.x = static_cast<float>(members_obs_[s].uv.x());
+    kp.y = static_cast<float>(members_obs_[s].uv.y());
+    f.bearings[r.cam][r.index] = members_obs_[s].bearing;
   }
   MultiViewFeature& mv = f.mv[f.mv_count];
   mv.first = first;

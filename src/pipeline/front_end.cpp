@@ -29,6 +29,7 @@ void FrontEnd::compute(const RigFrameView& frame, FrameFeatures& out) {
   for (int c = 0; c < cams; ++c) {
     const bool given = c < frame.cameras && frame.present && frame.present[c] && frame.images && !frame.images[c].empty();
     present_[c] = false;
+    images_[c] = ImageView{};
     if (!given) continue;
     const ImageView& img = frame.images[c];
     if (img.width != rig_.model(c).width() || img.height != rig_.model(c).height()) {
@@ -45,7 +46,7 @@ void FrontEnd::compute(const RigFrameView& frame, FrameFeatures& out) {
     if (!present_[c]) out.sets[c].count = 0;
   }
   const auto t1 = Clock::now();
-  matcher_.compute(out);
+  matcher_.compute(out, images_.data());  // the caller's images, alive for the call
   const auto t2 = Clock::now();
   timing_.extraction_ms = msBetween(t0, t1);
   timing_.multiview_ms = msBetween(t1, t2);

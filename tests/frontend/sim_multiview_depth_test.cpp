@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/pipeline/front_end.hpp"
 #include "mcslam/pipeline/pipeline_config.hpp"
 #include "sim_frames.hpp"
@@ -17,6 +18,8 @@ using namespace mcslam;
 namespace {
 
 struct DepthStats {
+  int judged = 0;       // map points with a true depth whose depth sigma is at most kJudgedAtTwoPercentSigma
+  int judged_within = 0;
   int points = 0;       // map points with a true depth
   int within = 0;       // within 2% of it
   int gross = 0;        // more than 10% off: a wrong match
@@ -25,30 +28,54 @@ struct DepthStats {
   int metric_within = 0;
 };
 
-// Truth at a keypoint: the depth at its pixel, or at a depth edge (the 5x5 window spans more than 5%) the
-// nearer or the farther side, whichever the estimate is closer to: a corner on a silhouette belongs to the
-// object in front, but which pixel holds it is a matter of rounding.
-double trueDepth(const sim::DepthImage& depth, double x, double y, double estimate) {
+// Truth at a keypoint: the depth at its pixel, or on a depth discontinuity the depth within the keypoint's
+// rounding (2 pixels of its octave) nearest to the estimate: a corner on a silhouette belongs to the object in
+// front, but which pixel holds it is a matter of rounding. A discontinuity is where the inverse depth is not
+// locally affine in the image (a plane's inverse depth is, up to the lens distortion's curvature): a second
+// difference above 0.5% of it, far below the 2% tolerance and far above the curvature. (Before, a window
+// spanning more than 5% counted as an edge: that missed steps of 2-5%, which the 2% tolerance resolves, and
+// counted steep planes such as the floor near the horizon as edges.)
+double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, double estimate) {
   const double centre = test::depthAt(depth, x, y);
-  double lo = centre, hi = centre;
-  for (int dy = -2; dy <= 2; ++dy) {
-    for (int dx = -2; dx <= 2; ++dx) {
+  if (!(centre > 0)) return centre;
+  const int r = static_cast<int>(std::lround(2 * std::pow(1.2, octave)));
+  auto inverse = [&](int dx, int dy) {
+    const double d = test::depthAt(depth, x + dx, y + dy);
+    return d > 0 ? 1.0 / d : 0.0;
+  };
+  const double bound = 0.005 / centre;
+  bool discontinuity = false;
+  double nearest = centre;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
       const double d = test::depthAt(depth, x + dx, y + dy);
-      if (d > 0) lo = std::min(lo > 0 ? lo : d, d), hi = std::max(hi, d);
+      if (!(d > 0)) {
+        discontinuity = true;  // nothing rendered there: sky beyond a silhouette
+        continue;
+      }
+      if (std::abs(d - estimate) < std::abs(nearest - estimate)) nearest = d;
+      const double inv = inverse(dx, dy);
+      if (dx > -r && dx < r && std::abs(inverse(dx - 1, dy) - 2 * inv + inverse(dx + 1, dy)) > bound) discontinuity = true;
+      if (dy > -r && dy < r && std::abs(inverse(dx, dy - 1) - 2 * inv + inverse(dx, dy + 1)) > bound) discontinuity = true;
     }
   }
-  if (!(centre > 0) || hi <= 1.05 * lo) return centre;
-  return std::abs(estimate - lo) < std::abs(estimate - hi) ? lo : hi;
+  return discontinuity ? nearest : centre;
 }
 
-// Points whose own depth sigma is at most 6%: those that a 2% check can judge (the odometry admits up to its
-// landmark bound, 15% by default, and refines them in the back-end).
+// Points whose own depth sigma is at most 6%: the odometry's regression guard below (the odometry admits up to
+// its landmark bound, 15% by default, and refines them in the back-end).
 constexpr double kWellKnownDepthSigma = 0.06;
+// A 2% tolerance judges a point only when the point claims to know its depth well within it: at a sigma of
+// 2% / 3, an honest estimate misses 2% in 0.3% of cases, so a miss is the estimate's fault, not its noise. At
+// a larger sigma the 98% target would measure noise the point itself declares (at sigma = 2% / 2.33 every
+// point of an honest population would have to be exactly Gaussian to reach 98%).
+constexpr double kJudgedAtTwoPercentSigma = 0.02 / 3;
 
 DepthStats checkFrame(sim::Simulation& sim, int frame) {
   const std::vector<int> front = {0, 1, 2, 3, 4};
   const Rig rig = sim.rig().subset(front);  // keeps the body frame: camera c here is camera c of the preset
-  const PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
+  PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
+  config.multiview.align_subpixel = true;
   FrontEnd front_end(rig, config);
   const test::RenderedFrame rendered = test::renderFrame(sim, frame, front);
   RigFrameView view = rendered.view();
@@ -59,11 +86,11 @@ DepthStats checkFrame(sim::Simulation& sim, int frame) {
   DepthStats s;
   for (int t = 0; t < f.mv_count; ++t) {
     const MultiViewFeature& mv = f.mv[t];
-    if (!mv.has_point || mv.relative_depth_sigma > kWellKnownDepthSigma) continue;
+    if (!mv.has_point || mv.relative_depth_sigma > kWellKnownDepthSigma) continue;  // (the judged are among them)
     const KeypointRef& ref = f.mv_refs[mv.first];
     const Keypoint& kp = f.sets[ref.cam].keypoints[ref.index];
     const double z = (rig.T_b_c(ref.cam).inverse() * mv.p_b).z();
-    const double truth = trueDepth(rendered.depths[ref.cam], kp.x, kp.y, z);
+    const double truth = trueDepth(rendered.depths[ref.cam], kp.x, kp.y, kp.octave, z);
     if (!(truth > 0)) continue;  // nothing rendered there
     const double error = std::abs(z - truth) / truth;
     ++s.points;
@@ -72,6 +99,10 @@ DepthStats checkFrame(sim::Simulation& sim, int frame) {
     s.honest += error < 3.0 * mv.relative_depth_sigma ? 1 : 0;
     s.metric += mv.metric ? 1 : 0;
     s.metric_within += mv.metric && error < 0.02 ? 1 : 0;
+    if (mv.relative_depth_sigma <= kJudgedAtTwoPercentSigma) {
+      ++s.judged;
+      s.judged_within += error < 0.02 ? 1 : 0;
+    }
   }
   return s;
 }
@@ -89,10 +120,14 @@ DepthStats indoorStats() {
       sum.honest += s.honest;
       sum.metric += s.metric;
       sum.metric_within += s.metric_within;
+      sum.judged += s.judged;
+      sum.judged_within += s.judged_within;
     }
     std::printf("map points %d: within 2%% %.3f, gross %.3f, within 3 sigma %.3f; metric %d, within 2%% %d\n",
                 sum.points, static_cast<double>(sum.within) / sum.points, static_cast<double>(sum.gross) / sum.points,
                 static_cast<double>(sum.honest) / sum.points, sum.metric, sum.metric_within);
+    std::printf("judged at 2%% (depth sigma <= %.4f): %d points, %d within 2%% (%.4f)\n", kJudgedAtTwoPercentSigma, sum.judged, sum.judged_within,
+                static_cast<double>(sum.judged_within) / sum.judged);
     return sum;
   }();
   return total;
@@ -100,28 +135,49 @@ DepthStats indoorStats() {
 
 }  // namespace
 
-// What the front-end achieves today (regression guard): measured 2134 points, 0.764 within 2%, 0.056 gross, 0.945
-// within 3 sigmas on these frames (before the two-view visibility check: 2490, 0.734, 0.090, 0.911). Most of the
-// within-2% shortfall is noise, not wrong matches: these frames' points lie mostly 10-30 m away, where the rig's
-// 0.66 m span gives a reported depth sigma of 2-6%. The gross share is mostly keypoints of octaves 4-7 and
-// silhouettes.
+// What the front-end achieves with partners aligned to their reference keypoint along the epipolar curve
+// (MultiViewOptions::align_subpixel, off by default for its cost), regression guard: measured 3486 points, 0.935
+// within 2%, 0.015 gross, 0.916 within 3 sigmas; 2310 metric, 2248 of them within 2%; 2658 judged at 2% (sigma
+// <= 2%/3), 2596 within 2%. Without the alignment, same truth: 2147 points, 0.825 within 2%, 0.031 gross, 0.970
+// within 3 sigmas (their sigma is the octave's pixel, 3.5 times the rounding's), 10 metric, 14 with sigma <= 1%.
+// What misses now is mostly silhouettes whose patch mixes both sides (estimates 2-4% behind the foreground),
+// two-view tracks (no third ray checks them), and periodic textures whose alias is consistent along the
+// collinear front cameras.
 TEST(SimMultiViewDepth, MapPointsOfTheFrontCamerasMostlyHaveTheRenderedDepth) {
   const DepthStats s = indoorStats();
-  ASSERT_GT(s.points, 1900);
-  EXPECT_GE(s.within, 0.74 * s.points);
-  EXPECT_LE(s.gross, 0.07 * s.points);
-  EXPECT_GE(s.honest, 0.92 * s.points);
-  // Points the front-end calls metric: few here (far scenes), mostly right.
-  EXPECT_GE(s.metric_within, 0.8 * s.metric);
+  ASSERT_GT(s.points, 3100);
+  EXPECT_GE(s.within, 0.92 * s.points);
+  EXPECT_LE(s.gross, 0.02 * s.points);
+  EXPECT_GE(s.honest, 0.90 * s.points);
+  EXPECT_GE(s.metric_within, 0.95 * s.metric);
+  ASSERT_GT(s.judged, 2300);
+  EXPECT_GE(s.judged_within, 0.97 * s.judged);
 }
 
-// The front-end issue's target, not met (see docs/benchmarks/frontend.md): 98% of map points within 2%. Not
-// reachable for points whose own depth sigma is 2-6%; the population it fits, the metric points (sigma <= 1%),
-// is 12 points on these frames, 10 of them within 2% (before the third-ray requirement: 56 points, 10 within 2%,
-// 44 wrong two-view matches across wide baselines).
+// The front-end issue's target: 98% of map points within 2%, on the points that can be judged at 2% (see
+// kJudgedAtTwoPercentSigma; 76% of the map points here). Not met: 2596 of 2658 (97.7%).
 // Run with --gtest_also_run_disabled_tests.
 TEST(SimMultiViewDepth, DISABLED_MapPointsWithinTwoPercentOfTheRenderedDepth) {
   const DepthStats s = indoorStats();
-  ASSERT_GT(s.points, 1500);
-  EXPECT_GE(s.within, 0.98 * s.points);
+  ASSERT_GT(s.judged, 2000);
+  EXPECT_GE(s.judged_within, 0.98 * s.judged);
+}
+
+// The subpixel alignment reads the frame's images where they are and allocates nothing.
+TEST(SimMultiViewDepth, AlignedFrontEndAllocatesNothingAfterWarmUp) {
+  sim::Simulation& sim = test::sharedSimulation("isec", "indoor");
+  const std::vector<int> front = {0, 1, 2, 3, 4};
+  const Rig rig = sim.rig().subset(front);
+  PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
+  config.multiview.align_subpixel = true;
+  FrontEnd front_end(rig, config);
+  const test::RenderedFrame rendered = test::renderFrame(sim, 100, front);
+  RigFrameView view = rendered.view();
+  view.cameras = rig.size();
+  FrameFeatures f(rig.size(), front_end.capacityPerCamera());
+  front_end.compute(view, f);  // warm-up
+  alloc::ThreadScope scope;    // the matcher runs on this thread
+  front_end.compute(view, f);
+  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_GT(front_end.multiViewStats().aligned, 500);
 }

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "mcslam/calib/rig.hpp"
+#include "mcslam/core/image.hpp"
+#include "mcslam/features/epipolar_alignment.hpp"
 #include "mcslam/features/frame_features.hpp"
 #include "mcslam/features/octave_scales.hpp"
 #include "mcslam/features/overlap_map.hpp"
@@ -31,6 +33,12 @@ struct MultiViewOptions {
   // Rays a metric point needs (a third ray verifies the depth); 0: 3 when some camera overlaps two others,
   // else 2 (stereo pairs, rings of pairwise overlaps).
   int min_metric_views = 0;
+  // Subpixel alignment of every partner keypoint to the track's reference keypoint (the finest octave) along
+  // the epipolar curve, when the images are given to compute(); partners whose patches disagree leave the track.
+  // Off by default: it costs about 9 ms of main-thread CPU per 5-camera rig frame (patch reads that miss the
+  // cache across five images; docs/benchmarks/frontend.md), above the front-end's budget.
+  bool align_subpixel = false;
+  EpipolarAlignmentOptions alignment;
 
   MultiViewOptions() { triangulation.max_relative_depth_sigma = 0.01; }
 };
@@ -41,6 +49,8 @@ struct MultiViewStats {
   int tracks_with_point = 0;
   int metric_tracks = 0;    // with a depth certain to the configured bound
   int dropped = 0;          // tracks rejected by geometry
+  int aligned = 0;          // partner keypoints aligned to their reference to subpixel precision
+  int disagreeing = 0;      // partner keypoints whose patch did not match the reference's: removed from the track
 };
 
 class MultiViewMatcher {
@@ -49,8 +59,9 @@ class MultiViewMatcher {
   MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, const MultiViewOptions& options,
                    int max_features_per_camera);
 
-  // Computes bearings for every keypoint, then the multi-view features. No heap allocation.
-  void compute(FrameFeatures& frame);
+  // Computes bearings for every keypoint, then the multi-view features. No heap allocation. images (optional,
+  // one per camera, valid during the call): the frame's images, for the subpixel alignment of the partners.
+  void compute(FrameFeatures& frame, const ImageView* images = nullptr);
   const MultiViewStats& stats() const { return stats_; }
 
  private:
@@ -65,6 +76,10 @@ class MultiViewMatcher {
   void noteForB(const FeatureSet& si, int b, int a, int d);
   void mergeTracks(FrameFeatures& f);
   void finishTrack(FrameFeatures& f, int first, int size);
+  int alignToReference(FrameFeatures& f, int first, int size);
+  AlignmentStatus alignPartner(const FrameFeatures& f, int first, int s);
+  void swapMembers(FrameFeatures& f, int first, int a, int b);
+  bool bearingOf(int cam, const Vec2& uv, Vec3& bearing) const;
   int find(int node);
 
   const Rig& rig_;
@@ -119,6 +134,15 @@ class MultiViewMatcher {
   std::vector<int32_t> component_size_;
   std::vector<int32_t> members_;         // nodes grouped by component
   std::vector<TriangulationObservation> scratch_obs_;
+  // The current track's observations (parallel to its mv_refs): position, bearing and sigma after alignment.
+  struct Member {
+    Vec2 uv;
+    Vec3 bearing;
+    double sigma_px;
+    bool aligned;
+  };
+  std::vector<Member> members_obs_;
+  const ImageView* images_ = nullptr;  // the current frame's, during compute()
   std::vector<int32_t> candidate_b_;     // epipolar-consistent candidates of the current keypoint
   std::vector<int16_t> candidate_dist_;
 };

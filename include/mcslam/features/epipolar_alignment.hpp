@@ -1,0 +1,56 @@
+#pragma once
+// Subpixel alignment of a matched keypoint along its epipolar curve: the patch around the reference keypoint
+// is found in the other camera's image by one-parameter Gauss-Newton (inverse compositional) on the shift along
+// the epipolar direction, with gain and bias normalised away (the residual is that of zero-mean normalised
+// cross-correlation). FAST keypoints are integer pixels of their octave; aligning the partner to the reference
+// pixel removes the partner's quantisation (up to half a pixel of its octave) from the disparity, which at
+// disparities of tens of pixels is several percent of the depth.
+//
+// The patch warp between the cameras is the local affine map A of the geometry (rotation, scale and lens
+// distortion about the point, the surface taken normal to the reference ray), given by the caller; only the
+// shift along the epipolar direction is estimated, so the aperture problem of edges cannot move the match off
+// the epipolar curve. No allocation: the patch lives on the stack.
+#include "mcslam/core/image.hpp"
+#include "mcslam/core/se3.hpp"
+
+namespace mcslam {
+
+struct EpipolarAlignmentOptions {
+  int half_size = 3;            // patch of (2 half_size + 1)^2 samples, spaced by the reference octave's scale
+  int max_iterations = 8;
+  double converged_px = 0.01;   // stop when a step is below this
+  // Patches that correlate less than this after alignment show different surfaces (a wrong match, or a depth
+  // edge where the two views see different backgrounds).
+  double min_zncc = 0.85;
+  // The shift may not exceed this many sample spacings (reference plus partner octave scales): both keypoints are
+  // within half a pixel of their octave of the corner, so a longer shift converged on another structure.
+  double max_shift_spacings = 1.0;
+  // Position sigma added in quadrature to the one the residual gives: bilinear interpolation and the affine patch
+  // model are not exact (a fraction of a sample spacing).
+  double sigma_floor_spacings = 0.05;
+};
+
+enum class AlignmentStatus : uint8_t {
+  Ok = 0,
+  NotRefinable,  // patch outside either image, no texture along the epipolar direction, singular warp
+  Disagrees,     // the patches do not correlate, or the shift left the keypoints' neighbourhood
+};
+
+struct EpipolarAlignment {
+  AlignmentStatus status = AlignmentStatus::NotRefinable;
+  Vec2 uv = Vec2::Zero();  // aligned position in the partner image
+  double shift = 0;        // along the direction, pixels
+  double sigma_px = 0;     // standard deviation of the position along the direction
+  double zncc = 0;
+  bool ok() const { return status == AlignmentStatus::Ok; }
+};
+
+// Finds the point of `image` that shows what `ref` shows at ref_uv. uv0: start on the epipolar curve (the
+// partner keypoint projected onto it); direction: unit tangent of the curve there; A: reference pixel offset ->
+// partner pixel offset; spacing: sample spacing in reference pixels (the reference octave's scale);
+// partner_spacing: the partner octave's scale (bounds the shift).
+EpipolarAlignment alignAlongEpipolar(const ImageView& ref, const Vec2& ref_uv, const ImageView& image, const Vec2& uv0,
+                                     const Vec2& direction, const Mat2& A, double spacing, double partner_spacing,
+                                     const EpipolarAlignmentOptions& options);
+
+}  // namespace mcslam
