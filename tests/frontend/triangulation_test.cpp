@@ -30,7 +30,7 @@ std::vector<TriangulationObservation> observe(const Rig& rig, const Vec3& p_b, d
 TEST(Triangulation, ExactRaysGiveTheExactPoint) {
   const Rig rig = test::isecRig();
   std::mt19937 rng(3);
-  for (const Vec3 p : {Vec3(0.3, 0.1, 2.0), Vec3(-0.5, 0.3, 6.0), Vec3(1.0, -0.2, 12.0)}) {
+  for (const Vec3& p : {Vec3(0.3, 0.1, 2.0), Vec3(-0.5, 0.3, 6.0), Vec3(1.0, -0.2, 12.0)}) {
     const auto obs = observe(rig, p, 0.0, rng);
     ASSERT_GE(obs.size(), 2u);
     const TriangulationResult r = triangulate(obs.data(), static_cast<int>(obs.size()), TriangulationOptions{});
