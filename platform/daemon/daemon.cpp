@@ -191,20 +191,25 @@ void Daemon::processingLoop() {
   processing_done_.store(true, std::memory_order_release);
 }
 
-void Daemon::wholeFrameLoop() {
-  const int cameras = static_cast<int>(sizes_.size());
+RigFrame* Daemon::nextRigFrame() {
   for (;;) {
     const uint32_t ticket = rig_bell_.ticket();
-    RigFrame* f = rig_ring_.acquire();
-    if (!f) {
-      if (stop_processing_.load(std::memory_order_relaxed)) break;
-      rig_bell_.wait(ticket, 50 * kMs);
-      continue;
-    }
-    for (int c = 0; c < cameras; ++c) views_[c] = f->images[c].view();
-    const RigFrameView view{f->capture_ns, f->sequence, cameras, views_.data(), f->present.get()};
+    if (RigFrame* f = rig_ring_.acquire()) return f;
+    if (stop_processing_.load(std::memory_order_relaxed)) return nullptr;
+    rig_bell_.wait(ticket, 50 * kMs);
+  }
+}
+
+RigFrameView Daemon::viewOf(const RigFrame& f) {
+  const int cameras = static_cast<int>(sizes_.size());
+  for (int c = 0; c < cameras; ++c) views_[c] = f.images[c].view();
+  return RigFrameView{f.capture_ns, f.sequence, cameras, views_.data(), f.present.get()};
+}
+
+void Daemon::wholeFrameLoop() {
+  while (RigFrame* f = nextRigFrame()) {
     PoseSlot& out = pose_ring_.writeSlot();
-    processor_->process(view, out.estimate);
+    processor_->process(viewOf(*f), out.estimate);
     out.trigger_mono_ns = f->trigger_mono_ns;
     out.cameras_present = f->presentCount();
     rig_ring_.release();
@@ -216,16 +221,8 @@ void Daemon::featuresLoop() {
   nameThisThread("mcslam-features");
   if (const auto why = setRealtimePriority(config_.realtime.processing_priority); !why.empty())
     spdlog::warn("features thread: {}", why);
-  const int cameras = static_cast<int>(sizes_.size());
   const uint64_t slots = staged_.size();
-  for (;;) {
-    const uint32_t ticket = rig_bell_.ticket();
-    RigFrame* f = rig_ring_.acquire();
-    if (!f) {
-      if (stop_processing_.load(std::memory_order_relaxed)) break;
-      rig_bell_.wait(ticket, 50 * kMs);
-      continue;
-    }
+  while (RigFrame* f = nextRigFrame()) {
     // A free slot (tracking finishes them in order); meanwhile new rig frames queue, and the oldest is
     // dropped when the rig ring is full, as without stages.
     for (;;) {
@@ -235,9 +232,7 @@ void Daemon::featuresLoop() {
     }
     const uint64_t head = staged_head_.load(std::memory_order_relaxed);
     const int slot = static_cast<int>(head % slots);
-    for (int c = 0; c < cameras; ++c) views_[c] = f->images[c].view();
-    const RigFrameView view{f->capture_ns, f->sequence, cameras, views_.data(), f->present.get()};
-    processor_->prepare(view, slot);
+    processor_->prepare(viewOf(*f), slot);
     staged_[static_cast<std::size_t>(slot)] = StagedFrame{f->trigger_mono_ns, f->presentCount()};
     rig_ring_.release();
     staged_head_.store(head + 1, std::memory_order_release);

@@ -78,6 +78,8 @@ class Daemon {
   void featuresLoop();    // stage one (prepare) on its own thread, when the processor has stages
   void trackingLoop();    // stage two (finish) on the processing thread
   void handOver(PoseSlot& out);  // a processed frame's pose to the publisher, warm-up bookkeeping
+  RigFrame* nextRigFrame();      // waits for the next rig frame; null once stopping and the ring is empty
+  RigFrameView viewOf(const RigFrame& f);  // views_ onto its images
   void publishingLoop();
   bool emitRigFrame(int64_t now, bool force);
   void publishPose(const PoseSlot& slot);
