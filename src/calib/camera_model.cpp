@@ -239,4 +239,17 @@ bool CameraModel::unproject(const Vec2& uv, Vec3& bearing) const {
   return true;
 }
 
+double CameraModel::imageHalfAngle() const {
+  constexpr int kStep = 4;
+  double widest = 0;
+  auto visit = [&](double x, double y) {
+    Vec3 b;
+    widest = unproject(Vec2(x, y), b) ? std::max(widest, std::acos(std::clamp(b.z(), -1.0, 1.0))) : M_PI;
+  };
+  for (int x = 0; x < width_; x += kStep) visit(x, 0), visit(x, height_ - 1);
+  for (int y = 0; y < height_; y += kStep) visit(0, y), visit(width_ - 1, y);
+  visit(width_ - 1, height_ - 1);
+  return widest;
+}
+
 }  // namespace mcslam

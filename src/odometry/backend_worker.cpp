@@ -1,7 +1,5 @@
 #include "backend_worker.hpp"
 
-#include <chrono>
-
 #include "mcslam/core/alloc_counter.hpp"
 
 namespace mcslam {
@@ -43,13 +41,10 @@ void BackendWorker::run() {
     const int iterations = iterations_;
     lock.unlock();
     const uint64_t allocations_before = alloc::threadCount();
-    const auto start = std::chrono::steady_clock::now();
     const backend::SolveSummary summary = solver.solve(iterations);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     const uint64_t allocated = alloc::threadCount() - allocations_before;
     lock.lock();
     summary_ = summary;
-    solve_ms_ = ms;
     allocations_ += allocated;
     pending_ = false;
     cv_.notify_all();

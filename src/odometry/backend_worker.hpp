@@ -21,7 +21,6 @@ class BackendWorker {
   void start(backend::SlidingWindowSolver& solver, int iterations);
   // Blocks until the solve started last has finished (at once when none runs) and returns its summary.
   backend::SolveSummary wait() const;
-  double lastSolveMs() const { return solve_ms_; }           // valid after wait()
   uint64_t allocations() const { return allocations_; }       // by this thread, all solves (after wait())
 
  private:
@@ -34,7 +33,6 @@ class BackendWorker {
   bool pending_ = false;  // a solve was started and has not finished
   bool stop_ = false;
   backend::SolveSummary summary_;
-  double solve_ms_ = 0;
   uint64_t allocations_ = 0;
   std::thread thread_;  // last: starts once the members above exist
 };

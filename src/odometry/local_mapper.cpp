@@ -3,7 +3,6 @@
 #include "backend_worker.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,16 +11,6 @@ namespace mcslam {
 
 namespace {
 
-
-// Angle from the optical axis to the farthest image corner.
-double halfFieldOfView(const CameraModel& m) {
-  double best = 0;
-  for (const Vec2& c : {Vec2(0, 0), Vec2(m.width() - 1, 0), Vec2(0, m.height() - 1), Vec2(m.width() - 1, m.height() - 1)}) {
-    Vec3 b;
-    if (m.unproject(c, b)) best = std::max(best, std::acos(std::clamp(b.z(), -1.0, 1.0)));
-  }
-  return best;
-}
 
 // Exact bounds: every keypoint of a window keyframe observes at most one landmark.
 backend::WindowCapacity windowCapacity(const OdometryOptions& o, const Map& map, int cameras, int features_per_camera) {
@@ -53,7 +42,7 @@ LocalMapper::LocalMapper(const Rig& rig, const OdometryOptions& options, Map& ma
   const int cams = rig.size();
   touched_.resize(map.landmarkCapacity());
   touched_flag_.assign(map.landmarkCapacity(), 0);
-  for (const RigCamera& c : rig.cameras) half_fov_.push_back(halfFieldOfView(c.model));
+  for (const RigCamera& c : rig.cameras) half_fov_.push_back(c.model.imageHalfAngle());
   candidates_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
   claim_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
   best_.resize(max_features_per_camera);
@@ -365,7 +354,6 @@ bool LocalMapper::optimize(int slot) {
 bool LocalMapper::beginOptimize(int slot) {
   if (!solver_) return false;
   finishOptimize();  // one window at a time
-  const auto start = std::chrono::steady_clock::now();
   Keyframe& kf = map_.keyframe(slot);
   if (solver_->isFull()) {
     const std::optional<int64_t> oldest = solver_->oldestKeyframe();
@@ -406,7 +394,6 @@ bool LocalMapper::beginOptimize(int slot) {
       }
     }
   }
-  prepare_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   solving_ = true;
   if (worker_) {
     worker_->start(*solver_, options_.backend_iterations);
@@ -419,7 +406,6 @@ bool LocalMapper::beginOptimize(int slot) {
 bool LocalMapper::finishOptimize() {
   if (!solving_) return false;
   solving_ = false;
-  const auto start = std::chrono::steady_clock::now();
   const backend::SolveSummary summary = worker_ ? worker_->wait() : inline_summary_;
   ++backend_solves_;
   // Outliers leave the back-end and the map (copied first: removing changes the solver's list).
@@ -451,8 +437,6 @@ bool LocalMapper::finishOptimize() {
       if (l.in_backend) solver_->landmarkPosition(map_.liveLandmarkSlots()[i], l.p_w);
     }
   }
-  const double apply_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  last_backend_ms_ = prepare_ms_ + (worker_ ? worker_->lastSolveMs() : 0.0) + apply_ms;
   return !summary.failed;
 }
 

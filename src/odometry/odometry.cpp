@@ -126,9 +126,7 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
       if (pending_keyframe_ < 0) {
         finishKeyframe(slot);  // no back-end: cull now
       } else if (!options_.backend_thread) {
-        const auto finish_start = Clock::now();
-        finishPendingKeyframe();
-        timing_.backend_ms += msSince(finish_start);
+        flush();  // the solve ran inline: apply it now, as before the back-end had a thread
       }
     }
   }
@@ -140,17 +138,13 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
 }
 
 void Odometry::flush() {
-  const auto start = Clock::now();
-  finishPendingKeyframe();
-  timing_.backend_ms += msSince(start);
-}
-
-void Odometry::finishPendingKeyframe() {
   if (pending_keyframe_ < 0) return;
   const int slot = pending_keyframe_;
   pending_keyframe_ = -1;
-  mapper_->finishOptimize();
-  finishKeyframe(slot);
+  const auto start = Clock::now();
+  mapper_->finishOptimize();  // waits for the solve when it runs on the back-end thread
+  timing_.backend_ms += msSince(start);
+  finishKeyframe(slot);  // its culling counts as mapping
 }
 
 void Odometry::finishKeyframe(int slot) {

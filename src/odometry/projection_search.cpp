@@ -44,29 +44,10 @@ bool FrameMatches::offer(int cam, int kp, int lm, int distance) {
   return true;
 }
 
-namespace {
-
-// Widest angle from the optical axis over the image border (where it is largest for any lens whose radial
-// mapping grows outwards), plus a degree; pi when a border pixel has no bearing (then no cone is assumed).
-double fieldHalfAngle(const CameraModel& m) {
-  constexpr int kStep = 4;
-  double widest = 0;
-  auto visit = [&](double x, double y) {
-    Vec3 b;
-    widest = m.unproject(Vec2(x, y), b) ? std::max(widest, std::acos(std::clamp(b.z(), -1.0, 1.0))) : M_PI;
-  };
-  for (int x = 0; x < m.width(); x += kStep) visit(x, 0), visit(x, m.height() - 1);
-  for (int y = 0; y < m.height(); y += kStep) visit(0, y), visit(m.width() - 1, y);
-  visit(m.width() - 1, m.height() - 1);
-  return std::min(M_PI, widest + M_PI / 180.0);
-}
-
-}  // namespace
-
 ProjectionSearch::ProjectionSearch(const Rig& rig, int max_features_per_camera) : rig_(rig), T_c_w_(rig.size()) {
   for (const RigCamera& c : rig.cameras) {
     grids_.emplace_back(c.model.width(), c.model.height(), 24, max_features_per_camera);
-    cos_field_.push_back(std::cos(fieldHalfAngle(c.model)));
+    cos_field_.push_back(std::cos(std::min(M_PI, c.model.imageHalfAngle() + M_PI / 180.0)));  // a degree of margin
   }
 }
 

@@ -47,6 +47,10 @@ class CameraModel {
 
   // Largest angle from the optical axis that projects validly, radians.
   double maxValidAngle() const { return max_angle_; }
+  // Widest angle from the optical axis that a pixel of the image sees, radians: the maximum over the image border
+  // (where it lies for any lens whose radial mapping grows outwards), sampled every 4 pixels; pi when a border
+  // pixel has no bearing. No point outside this cone projects into the image.
+  double imageHalfAngle() const;
 
   // Distortion applied to a point on the normalised plane (radtan) or to the unit-plane
   // direction scaled by the angle (equidistant); exposed for tests and the simulator.

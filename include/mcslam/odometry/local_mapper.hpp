@@ -48,9 +48,6 @@ class LocalMapper {
 
   void reset();
   Rig refinedRig() const;
-  // Back-end milliseconds of the last keyframe: preparation, solve and applying it (the solve ran beside
-  // tracking when on its own thread).
-  double lastBackendMs() const { return last_backend_ms_; }
   // Heap allocations made by the back-end thread, all solves (0 without it): for the fixed-memory tests.
   uint64_t backendThreadAllocations() const;
   uint64_t backendSolves() const { return backend_solves_; }
@@ -70,11 +67,10 @@ class LocalMapper {
   std::unique_ptr<BackendWorker> worker_;  // null: the solve runs inside beginOptimize()
   bool solving_ = false;
   backend::SolveSummary inline_summary_;
-  double prepare_ms_ = 0;
   std::vector<int32_t> touched_;
   std::vector<uint8_t> touched_flag_;
   int touched_count_ = 0;
-  std::vector<double> half_fov_;  // per camera: angle from the optical axis to the image corner
+  std::vector<double> half_fov_;  // per camera: CameraModel::imageHalfAngle()
   // Scratch for epipolar matching into a previous keyframe.
   struct Candidate {
     int16_t cam_new, cam_old;
@@ -98,7 +94,6 @@ class LocalMapper {
   int capacity_;
   OctaveScales octave_scale_{options_.scale_factor};
   bool monocular_ = false;
-  double last_backend_ms_ = 0;
   uint64_t backend_solves_ = 0;
 };
 

@@ -49,8 +49,8 @@ class Odometry {
 
   // Estimates the pose of one rig frame whose features (and multi-view features) are computed.
   void process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
-  // Completes the back-end work of the last keyframe (process() does it first thing): call it after the last
-  // frame, before reading the map's final keyframes.
+  // Completes the back-end work of the last keyframe: waits for its solve, applies it, then finishKeyframe().
+  // process() does it first thing; call it after the last frame, before reading the map's final keyframes.
   void flush();
 
   const OdometryStats& stats() const { return stats_; }
@@ -74,7 +74,6 @@ class Odometry {
   int poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b);
   bool needKeyframe(const SE3& T_w_b, int inliers, uint64_t frame_index) const;
   int countKeyframeLandmarks(int slot) const;
-  void finishPendingKeyframe();  // waits for the back-end's solve of pending_keyframe_, then finishKeyframe()
   void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
   void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
