@@ -20,6 +20,7 @@ FeatureWorkers::FeatureWorkers(const OrbOptions& options, const std::vector<Imag
     threads = std::min(cameras(), cores);
   }
   threads = std::min(threads, cameras());  // a thread without a camera would only wait
+  done_.assign(static_cast<size_t>(cameras()), 0);
   extractors_.reserve(static_cast<size_t>(threads));
   for (int i = 0; i < threads; ++i) extractors_.emplace_back(options, largest.width, largest.height);
   threads_.reserve(static_cast<size_t>(threads));
@@ -35,6 +36,13 @@ FeatureWorkers::~FeatureWorkers() {
   for (std::thread& t : threads_) t.join();
 }
 
+void FeatureWorkers::setFollowUp(ExtractionFollowUp* follow_up) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  follow_up_ = follow_up;
+  tasks_ = follow_up != nullptr ? follow_up->taskCount() : 0;
+  taken_.assign(static_cast<size_t>(tasks_), 0);
+}
+
 void FeatureWorkers::extract(const ImageView* images, const bool* present, FeatureSet* out, OrbStatus* status) {
   std::unique_lock<std::mutex> lock(mutex_);
   images_ = images;
@@ -42,7 +50,10 @@ void FeatureWorkers::extract(const ImageView* images, const bool* present, Featu
   out_ = out;
   status_ = status;
   next_camera_ = 0;
-  remaining_ = cameras();
+  std::fill(done_.begin(), done_.end(), 0);
+  std::fill(taken_.begin(), taken_.end(), 0);
+  untaken_tasks_ = tasks_;
+  remaining_ = cameras() + tasks_;
   ++frame_;
   work_ready_.notify_all();
   work_done_.wait(lock, [this] { return remaining_ == 0; });
@@ -72,15 +83,43 @@ void FeatureWorkers::run(int thread) {
     work_ready_.wait(lock, [&] { return stopping_ || frame_ != seen; });
     if (stopping_) return;
     seen = frame_;
-    // Take cameras until none is left for this frame; extract outside the lock.
-    while (next_camera_ < cameras()) {
-      const int camera = next_camera_++;
-      lock.unlock();
-      processCamera(camera, extractor);
-      lock.lock();
+    // Cameras first (the tasks wait for them), then the tasks whose cameras are done; work outside the lock.
+    while (true) {
+      if (next_camera_ < cameras()) {
+        const int camera = next_camera_++;
+        lock.unlock();
+        processCamera(camera, extractor);
+        if (follow_up_ != nullptr) follow_up_->afterCamera(camera);
+        lock.lock();
+        done_[static_cast<size_t>(camera)] = 1;
+        camera_done_.notify_all();
+      } else if (untaken_tasks_ > 0) {
+        const int task = takeReadyTask();
+        if (task < 0) {  // its cameras are being extracted by other threads
+          camera_done_.wait(lock);
+          continue;
+        }
+        lock.unlock();
+        follow_up_->runTask(task, thread);
+        lock.lock();
+      } else {
+        break;
+      }
       if (--remaining_ == 0) work_done_.notify_one();
     }
   }
+}
+
+int FeatureWorkers::takeReadyTask() {
+  for (int t = 0; t < tasks_; ++t) {
+    if (taken_[static_cast<size_t>(t)]) continue;
+    const auto [a, b] = follow_up_->taskCameras(t);
+    if (!done_[static_cast<size_t>(a)] || !done_[static_cast<size_t>(b)]) continue;
+    taken_[static_cast<size_t>(t)] = 1;
+    --untaken_tasks_;
+    return t;
+  }
+  return -1;
 }
 
 }  // namespace mcslam

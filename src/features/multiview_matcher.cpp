@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
+#include <string>
 
 #include "mcslam/core/error.hpp"
 
@@ -55,11 +56,25 @@ void hammingBatch(const Descriptor& a, const Descriptor* set, const int32_t* ind
 
 }  // namespace
 
+MultiViewMatcher::PairScratch::PairScratch(int capacity, int max_cells)
+    : plane_angle(capacity),
+      sorted_b(capacity),
+      sorted_angle(capacity),
+      sorted_candidates(capacity),
+      near_epipole_b(capacity),
+      cell_stamp(max_cells, 0),
+      best_for_b(capacity),
+      best_dist_for_b(capacity),
+      second_dist_for_b(capacity),
+      candidate_b(capacity),
+      candidate_dist(capacity) {}
+
 MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, const MultiViewOptions& options,
-                                   int max_features_per_camera)
+                                   int max_features_per_camera, int threads)
     : rig_(rig), overlap_(overlap), options_(options), capacity_(max_features_per_camera) {
   const int n = rig.size();
   if (n > 64) throw InputError("multi-view features support at most 64 cameras per rig");
+  if (threads < 1) throw InputError("multi-view features: threads = " + std::to_string(threads) + ", at least 1");
   for (int o = 0; o < kMaxOctaves; ++o) {
     same_px2_[o] = (options_.duplicate_px * sigma_[o]) * (options_.duplicate_px * sigma_[o]);
   }
@@ -94,20 +109,12 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
     }
     max_cells = std::max(max_cells, overlap.grid(c).cells());
   }
-  cell_stamp_.assign(max_cells, 0);
-  plane_angle_.resize(capacity_);
-  sorted_b_.resize(capacity_);
-  sorted_angle_.resize(capacity_);
-  sorted_candidates_.resize(capacity_);
-  near_epipole_b_.resize(capacity_);
+  scratch_.reserve(static_cast<std::size_t>(threads));
+  for (int t = 0; t < threads; ++t) scratch_.emplace_back(capacity_, max_cells);
   const std::size_t pairs = overlap.overlappingPairs().size();
   matches_.resize(std::max<std::size_t>(1, pairs * capacity_));
+  pair_matches_.assign(pairs, 0);
   order_.resize(matches_.size());
-  best_for_b_.resize(capacity_);
-  best_dist_for_b_.resize(capacity_);
-  second_dist_for_b_.resize(capacity_);
-  candidate_b_.resize(capacity_);
-  candidate_dist_.resize(capacity_);
   parent_.resize(static_cast<std::size_t>(n) * capacity_);
   camera_mask_.resize(parent_.size());
   component_of_root_.resize(parent_.size());
@@ -119,19 +126,46 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
 }
 
 void MultiViewMatcher::compute(FrameFeatures& f, const ImageView* images) {
+  beginFrame(f, images);
+  for (int c = 0; c < f.cameras(); ++c) prepareCamera(f, c);
+  for (int p = 0; p < pairCount(); ++p) matchPair(f, p, 0);
+  finishFrame(f);
+}
+
+void MultiViewMatcher::beginFrame(FrameFeatures& f, const ImageView* images) {
   stats_ = MultiViewStats{};
   images_ = options_.align_subpixel ? images : nullptr;
   f.mv_count = 0;
   f.mv_ref_count = 0;
-  computeBearings(f);
-  bucketKeypoints(f);
-  match_count_ = 0;
-  for (const auto& [i, j] : overlap_.overlappingPairs()) {
-    if (f.present[i] && f.present[j]) matchPair(f, i, j);
-  }
+  std::fill(pair_matches_.begin(), pair_matches_.end(), 0);
+}
+
+void MultiViewMatcher::prepareCamera(FrameFeatures& f, int camera) {
+  computeBearings(f, camera);
+  bucketKeypoints(f, camera);
+}
+
+void MultiViewMatcher::matchPair(const FrameFeatures& f, int pair, int thread) {
+  const auto [i, j] = pairCameras(pair);
+  Match* slot = matches_.data() + static_cast<std::size_t>(pair) * capacity_;
+  pair_matches_[pair] = f.present[i] && f.present[j] ? matchCameras(f, i, j, scratch_[thread], slot) : 0;
+}
+
+void MultiViewMatcher::finishFrame(FrameFeatures& f) {
+  gatherMatches();
   stats_.pair_matches = match_count_;
   mergeTracks(f);
   images_ = nullptr;
+}
+
+// The pairs' slots moved to the front, in pair order (each slot starts at or after its destination).
+void MultiViewMatcher::gatherMatches() {
+  match_count_ = 0;
+  for (int p = 0; p < pairCount(); ++p) {
+    const Match* slot = matches_.data() + static_cast<std::size_t>(p) * capacity_;
+    std::copy(slot, slot + pair_matches_[p], matches_.data() + match_count_);
+    match_count_ += pair_matches_[p];
+  }
 }
 
 // A keypoint's bearing: interpolated on the camera's grid and polished by one Gauss-Newton step on the
@@ -167,38 +201,34 @@ bool MultiViewMatcher::bearingOf(int cam, const Vec2& uv, Vec3& bearing) const {
   return model.unproject(uv, bearing);
 }
 
-void MultiViewMatcher::computeBearings(FrameFeatures& f) {
-  for (int c = 0; c < f.cameras(); ++c) {
-    const Mat3 R_b_c = rig_.T_b_c(c).R;
-    const FeatureSet& s = f.sets[c];
-    for (int k = 0; k < s.count; ++k) {
-      const bool ok = bearingOf(c, Vec2(s.keypoints[k].x, s.keypoints[k].y), f.bearings[c][k]);
-      f.valid[c][k] = ok ? 1 : 0;
-      f.mv_of[c][k] = -1;
-      dir_b_[c][k] = R_b_c * f.bearings[c][k];
-    }
+void MultiViewMatcher::computeBearings(FrameFeatures& f, int c) {
+  const Mat3 R_b_c = rig_.T_b_c(c).R;
+  const FeatureSet& s = f.sets[c];
+  for (int k = 0; k < s.count; ++k) {
+    const bool ok = bearingOf(c, Vec2(s.keypoints[k].x, s.keypoints[k].y), f.bearings[c][k]);
+    f.valid[c][k] = ok ? 1 : 0;
+    f.mv_of[c][k] = -1;
+    dir_b_[c][k] = R_b_c * f.bearings[c][k];
   }
 }
 
-void MultiViewMatcher::bucketKeypoints(const FrameFeatures& f) {
-  for (int c = 0; c < f.cameras(); ++c) {
-    const CellGrid& g = overlap_.grid(c);
-    std::vector<int32_t>& start = cell_start_[c];
-    std::fill(start.begin(), start.end(), 0);
-    const FeatureSet& s = f.sets[c];
-    for (int k = 0; k < s.count; ++k) {
-      const int cell = g.cellOf(s.keypoints[k].x, s.keypoints[k].y);
-      cell_of_[c][k] = cell;
-      if (cell >= 0) ++start[cell + 1];
-    }
-    for (int i = 0; i < g.cells(); ++i) start[i + 1] += start[i];
-    // Fill using the start offsets as cursors, then shift them back.
-    for (int k = 0; k < s.count; ++k) {
-      if (cell_of_[c][k] >= 0) cell_items_[c][start[cell_of_[c][k]]++] = k;
-    }
-    for (int i = g.cells(); i > 0; --i) start[i] = start[i - 1];
-    start[0] = 0;
+void MultiViewMatcher::bucketKeypoints(const FrameFeatures& f, int c) {
+  const CellGrid& g = overlap_.grid(c);
+  std::vector<int32_t>& start = cell_start_[c];
+  std::fill(start.begin(), start.end(), 0);
+  const FeatureSet& s = f.sets[c];
+  for (int k = 0; k < s.count; ++k) {
+    const int cell = g.cellOf(s.keypoints[k].x, s.keypoints[k].y);
+    cell_of_[c][k] = cell;
+    if (cell >= 0) ++start[cell + 1];
   }
+  for (int i = 0; i < g.cells(); ++i) start[i + 1] += start[i];
+  // Fill using the start offsets as cursors, then shift them back.
+  for (int k = 0; k < s.count; ++k) {
+    if (cell_of_[c][k] >= 0) cell_items_[c][start[cell_of_[c][k]]++] = k;
+  }
+  for (int i = g.cells(); i > 0; --i) start[i] = start[i - 1];
+  start[0] = 0;
 }
 
 // Epipolar geometry about the baseline: every epipolar plane of the pair contains the baseline, so it is
@@ -206,12 +236,12 @@ void MultiViewMatcher::bucketKeypoints(const FrameFeatures& f) {
 // same half-plane seen from either camera (the two rays differ by a multiple of the baseline). Camera j's
 // keypoints are sorted by that angle once per pair; each keypoint of camera i then visits only those of its
 // angle window (the band around its epipolar curve), and only in the overlap map's candidate cells.
-void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
+int MultiViewMatcher::matchCameras(const FrameFeatures& f, int i, int j, PairScratch& sc, Match* out) const {
   const FeatureSet& si = f.sets[i];
   const FeatureSet& sj = f.sets[j];
   const Vec3 baseline = rig_.T_b_c(j).t - rig_.T_b_c(i).t;  // body frame
   const double baseline_norm = baseline.norm();
-  if (!(baseline_norm > 1e-9)) return;  // common centre: no epipolar geometry
+  if (!(baseline_norm > 1e-9)) return 0;  // common centre: no epipolar geometry
   const Vec3 e = baseline / baseline_norm;
   const Vec3 u = e.unitOrthogonal();
   const Vec3 v = e.cross(u);
@@ -232,28 +262,28 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
     const double x = u.dot(d), y = v.dot(d);
     const double sine = std::sqrt(x * x + y * y);  // of the angle between the bearing and the baseline
     if (sine < kNearEpipoleSine) {
-      near_epipole_b_[near++] = b;
+      sc.near_epipole_b[near++] = b;
       continue;
     }
-    plane_angle_[b] = static_cast<float>(std::atan2(y, x));
+    sc.plane_angle[b] = static_cast<float>(std::atan2(y, x));
     min_sine = std::min(min_sine, sine);
-    sorted_b_[sorted++] = b;
+    sc.sorted_b[sorted++] = b;
   }
   // By octave, then plane angle: a keypoint of camera i scans only the octaves it may match, each with the
   // window of its own gate.
   auto octaveOf = [&](int b) { return std::clamp<int>(sj.keypoints[b].octave, 0, kMaxOctaves - 1); };
-  std::sort(sorted_b_.begin(), sorted_b_.begin() + sorted, [&](int32_t p, int32_t q) {
+  std::sort(sc.sorted_b.begin(), sc.sorted_b.begin() + sorted, [&](int32_t p, int32_t q) {
     const int op = octaveOf(p), oq = octaveOf(q);
-    return op != oq ? op < oq : plane_angle_[p] < plane_angle_[q];
+    return op != oq ? op < oq : sc.plane_angle[p] < sc.plane_angle[q];
   });
   int octave_start[kMaxOctaves + 1] = {};
-  for (int k = 0; k < sorted; ++k) ++octave_start[octaveOf(sorted_b_[k]) + 1];
+  for (int k = 0; k < sorted; ++k) ++octave_start[octaveOf(sc.sorted_b[k]) + 1];
   for (int o = 0; o < kMaxOctaves; ++o) octave_start[o + 1] += octave_start[o];
   for (int k = 0; k < sorted; ++k) {
-    const int b = sorted_b_[k];
+    const int b = sc.sorted_b[k];
     const Vec3& d = dir_b_[j][b];
-    sorted_angle_[k] = plane_angle_[b];
-    sorted_candidates_[k] = Candidate{plane_angle_[b], b, cell_of_[j][b], sj.keypoints[b].octave,
+    sc.sorted_angle[k] = sc.plane_angle[b];
+    sc.sorted_candidates[k] = Candidate{sc.plane_angle[b], b, cell_of_[j][b], sj.keypoints[b].octave,
                                       {static_cast<float>(d.x()), static_cast<float>(d.y()), static_cast<float>(d.z())}};
   }
   // Half-width of the angle window per octave of the keypoint in j: |n . d| = sine * |sin(angle difference)|.
@@ -263,23 +293,23 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
     window[o] = s >= 1.0 ? M_PI : std::asin(s) + 1e-5;  // margin for the float angles
   }
 
-  std::fill(best_for_b_.begin(), best_for_b_.begin() + sj.count, -1);
-  std::fill(best_dist_for_b_.begin(), best_dist_for_b_.begin() + sj.count, int16_t{257});
-  std::fill(second_dist_for_b_.begin(), second_dist_for_b_.begin() + sj.count, int16_t{257});
-  const int first_match = match_count_;
+  std::fill(sc.best_for_b.begin(), sc.best_for_b.begin() + sj.count, -1);
+  std::fill(sc.best_dist_for_b.begin(), sc.best_dist_for_b.begin() + sj.count, int16_t{257});
+  std::fill(sc.second_dist_for_b.begin(), sc.second_dist_for_b.begin() + sj.count, int16_t{257});
+  int count = 0;
   const CellGrid& gi = overlap_.grid(i);
-  const float* angles = sorted_angle_.data();
+  const float* angles = sc.sorted_angle.data();
 
   for (int cell_i = 0; cell_i < gi.cells(); ++cell_i) {
     const int32_t begin = cell_start_[i][cell_i], end = cell_start_[i][cell_i + 1];
     if (begin == end) continue;
     const std::span<const int32_t> cells_j = overlap_.candidates(i, j, cell_i);
     if (cells_j.empty()) continue;
-    if (++stamp_ == 0) {  // wrapped: clear the old stamps
-      std::fill(cell_stamp_.begin(), cell_stamp_.end(), 0u);
-      stamp_ = 1;
+    if (++sc.stamp == 0) {  // wrapped: clear the old stamps
+      std::fill(sc.cell_stamp.begin(), sc.cell_stamp.end(), 0u);
+      sc.stamp = 1;
     }
-    for (const int32_t c : cells_j) cell_stamp_[c] = stamp_;
+    for (const int32_t c : cells_j) sc.cell_stamp[c] = sc.stamp;
 
     for (int32_t item = begin; item < end; ++item) {
       const int a = cell_items_[i][item];
@@ -294,16 +324,16 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
       const int oa = si.keypoints[a].octave;
       int candidates = 0;
       auto consider = [&](int b) {
-        if (cell_stamp_[cell_of_[j][b]] != stamp_) return;
+        if (sc.cell_stamp[cell_of_[j][b]] != sc.stamp) return;
         const int ob = sj.keypoints[b].octave;
         if (std::abs(oa - ob) > options_.max_octave_difference) return;
         const Vec3& db = dir_b_[j][b];
         if (std::abs(n.dot(db)) > gate[std::min(ob, kMaxOctaves - 1)]) return;
-        candidate_b_[candidates++] = b;
+        sc.candidate_b[candidates++] = b;
       };
       // The same tests on the packed copy (float bearing: its rounding is far below any gate).
       const float nf[3] = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
-      const Candidate* packed = sorted_candidates_.data();
+      const Candidate* packed = sc.sorted_candidates.data();
       const double angle = std::atan2(v.dot(da), u.dot(da));
       const int o_lo = std::max(0, oa - options_.max_octave_difference);
       const int o_hi = std::min(kMaxOctaves - 1, oa + options_.max_octave_difference);
@@ -312,10 +342,10 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
         if (first_k == last_k) continue;
         const float g = gate_f[ob];
         auto considerPacked = [&](const Candidate& cand) {
-          if (cell_stamp_[cand.cell] != stamp_) return;
+          if (sc.cell_stamp[cand.cell] != sc.stamp) return;
           const float dot = nf[0] * cand.d[0] + nf[1] * cand.d[1] + nf[2] * cand.d[2];
           if (std::abs(dot) > g) return;
-          candidate_b_[candidates++] = cand.b;
+          sc.candidate_b[candidates++] = cand.b;
         };
         const double w = window[ob];
         if (w >= M_PI) {
@@ -340,21 +370,21 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
         }
       }
       for (int k = 0; k < near; ++k) {
-        const int b = near_epipole_b_[k];
+        const int b = sc.near_epipole_b[k];
         if (perp.dot(dir_b_[j][b]) > 0) consider(b);
       }
       if (candidates == 0) continue;
-      hammingBatch(si.descriptors[a], sj.descriptors.data(), candidate_b_.data(), candidates,
-                     candidate_dist_.data());
+      hammingBatch(si.descriptors[a], sj.descriptors.data(), sc.candidate_b.data(), candidates,
+                     sc.candidate_dist.data());
       int best = 257, best_b = -1;
       for (int c = 0; c < candidates; ++c) {
-        const int d = candidate_dist_[c];
-        const int b = candidate_b_[c];
+        const int d = sc.candidate_dist[c];
+        const int b = sc.candidate_b[c];
         if (d < best) {
           best = d;
           best_b = b;
         }
-        noteForB(si, b, a, d);
+        noteForB(si, b, a, d, sc);
       }
       if (best_b < 0 || best > options_.max_hamming) continue;
       // Ratio test against the best candidate elsewhere on the epipolar curve. The pyramid detects one corner
@@ -363,12 +393,12 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
       const double same2 = same_px2_[std::clamp<int>(kb.octave, 0, kMaxOctaves - 1)];
       int second = 257;
       for (int c = 0; c < candidates; ++c) {
-        const Keypoint& kc = sj.keypoints[candidate_b_[c]];
+        const Keypoint& kc = sj.keypoints[sc.candidate_b[c]];
         const double dx = kc.x - kb.x, dy = kc.y - kb.y;
-        if (candidate_dist_[c] < second && dx * dx + dy * dy > same2) second = candidate_dist_[c];
+        if (sc.candidate_dist[c] < second && dx * dx + dy * dy > same2) second = sc.candidate_dist[c];
       }
       if (!(best < options_.ratio * second)) continue;
-      matches_[match_count_++] = Match{static_cast<int16_t>(i), static_cast<int16_t>(j), a, best_b,
+      out[count++] = Match{static_cast<int16_t>(i), static_cast<int16_t>(j), a, best_b,
                                        static_cast<int16_t>(best)};
     }
   }
@@ -376,20 +406,20 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int i, int j) {
   // and clearly better than any other corner of camera i on the same epipolar curve. One way is not enough:
   // on periodic texture (books, bricks, tiles) the true partner of a may be missing in j while a's repetitions
   // in camera i all compete for the same b, and along a linear camera array an alias stays consistent in all views.
-  int kept = first_match;
-  for (int m = first_match; m < match_count_; ++m) {
-    const int b = matches_[m].kp_b;
-    if (best_for_b_[b] == matches_[m].kp_a && best_dist_for_b_[b] < options_.ratio * second_dist_for_b_[b]) {
-      matches_[kept++] = matches_[m];
+  int kept = 0;
+  for (int m = 0; m < count; ++m) {
+    const int b = out[m].kp_b;
+    if (sc.best_for_b[b] == out[m].kp_a && sc.best_dist_for_b[b] < options_.ratio * sc.second_dist_for_b[b]) {
+      out[kept++] = out[m];
     }
   }
-  match_count_ = kept;
+  return kept;
 }
 
 // Best and second best keypoint of camera i for keypoint b of camera j, the second ignoring copies of the best
 // (the same corner detected at another octave).
-void MultiViewMatcher::noteForB(const FeatureSet& si, int b, int a, int d) {
-  const int best_a = best_for_b_[b];
+void MultiViewMatcher::noteForB(const FeatureSet& si, int b, int a, int d, PairScratch& sc) const {
+  const int best_a = sc.best_for_b[b];
   bool copy_of_best = false;
   if (best_a >= 0) {
     const Keypoint& ka = si.keypoints[a];
@@ -397,12 +427,12 @@ void MultiViewMatcher::noteForB(const FeatureSet& si, int b, int a, int d) {
     const double dx = ka.x - kb.x, dy = ka.y - kb.y;
     copy_of_best = dx * dx + dy * dy <= same_px2_[std::clamp<int>(std::max(ka.octave, kb.octave), 0, kMaxOctaves - 1)];
   }
-  if (d < best_dist_for_b_[b]) {
-    if (!copy_of_best) second_dist_for_b_[b] = best_dist_for_b_[b];
-    best_dist_for_b_[b] = static_cast<int16_t>(d);
-    best_for_b_[b] = a;
-  } else if (d < second_dist_for_b_[b] && !copy_of_best) {
-    second_dist_for_b_[b] = static_cast<int16_t>(d);
+  if (d < sc.best_dist_for_b[b]) {
+    if (!copy_of_best) sc.second_dist_for_b[b] = sc.best_dist_for_b[b];
+    sc.best_dist_for_b[b] = static_cast<int16_t>(d);
+    sc.best_for_b[b] = a;
+  } else if (d < sc.second_dist_for_b[b] && !copy_of_best) {
+    sc.second_dist_for_b[b] = static_cast<int16_t>(d);
   }
 }
 

@@ -19,9 +19,11 @@ FrontEnd::FrontEnd(const Rig& rig, const PipelineConfig& config)
       capacity_(config.orb.max_features),
       overlap_(rig, config.overlap),
       workers_(config.orb, imageSizes(rig), config.feature_threads),
-      matcher_(rig, overlap_, config.multiview, config.orb.max_features),
+      matcher_(rig, overlap_, config.multiview, config.orb.max_features, workers_.threads()),
       images_(rig.size()),
-      present_(new bool[rig.size()]) {}
+      present_(new bool[rig.size()]) {
+  workers_.setFollowUp(&matching_tasks_);
+}
 
 void FrontEnd::compute(const RigFrameView& frame, FrameFeatures& out) {
   const auto t0 = Clock::now();
@@ -40,13 +42,12 @@ void FrontEnd::compute(const RigFrameView& frame, FrameFeatures& out) {
     present_[c] = true;
   }
   out.t = frame.t;
-  workers_.extract(images_.data(), present_.get(), out.sets.data());
-  for (int c = 0; c < cams; ++c) {
-    out.present[c] = present_[c] ? 1 : 0;
-    if (!present_[c]) out.sets[c].count = 0;
-  }
+  for (int c = 0; c < cams; ++c) out.present[c] = present_[c] ? 1 : 0;  // read by the matching tasks
+  matcher_.beginFrame(out, images_.data());  // the caller's images, alive for the call
+  matching_tasks_.setFrame(&out);
+  workers_.extract(images_.data(), present_.get(), out.sets.data());  // an absent camera gets no keypoints
   const auto t1 = Clock::now();
-  matcher_.compute(out, images_.data());  // the caller's images, alive for the call
+  matcher_.finishFrame(out);
   const auto t2 = Clock::now();
   timing_.extraction_ms = msBetween(t0, t1);
   timing_.multiview_ms = msBetween(t1, t2);

@@ -1,7 +1,9 @@
 // FeatureWorkers: same features as one extractor per camera, whatever the thread count; absent
-// cameras; no allocation per rig frame; clean start and stop.
+// cameras; follow-up tasks run once each, after both of their cameras; no allocation per rig frame; clean
+// start and stop.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <thread>
 
 #include "mcslam/core/alloc_counter.hpp"
@@ -122,6 +124,80 @@ TEST(FeatureWorkers, RigFramesAllocateNothingOnAnyThread) {
   for (int frame = 0; frame < 5; ++frame) workers.extract(rig().views.data(), present, out.data());
   EXPECT_EQ(alloc::totalCount() - before, 0u);
   EXPECT_GT(out[4].count, 0);
+}
+
+// Records, per frame, when each camera's follow-up ran and whether each task saw both of its cameras done.
+class RecordingFollowUp : public ExtractionFollowUp {
+ public:
+  explicit RecordingFollowUp(const std::vector<FeatureSet>& out) : out_(out) {
+    for (int a = 0; a < kCameras; ++a) {
+      for (int b = a + 1; b < kCameras; ++b) pairs_.push_back({a, b});
+    }
+    pairs_.push_back({4, 0});  // any order of the two cameras
+  }
+  void reset() {
+    for (auto& d : camera_done_) d = 0;
+    for (auto& r : task_runs_) r = 0;
+    for (auto& ok : task_saw_cameras_) ok = 1;
+  }
+  void afterCamera(int camera) override {
+    seen_count_[camera] = out_[static_cast<size_t>(camera)].count;  // the camera's features are final
+    camera_done_[camera].store(1);
+  }
+  int taskCount() const override { return static_cast<int>(pairs_.size()); }
+  std::pair<int, int> taskCameras(int task) const override { return pairs_[static_cast<size_t>(task)]; }
+  void runTask(int task, int thread) override {
+    const auto [a, b] = pairs_[static_cast<size_t>(task)];
+    if (!camera_done_[a].load() || !camera_done_[b].load()) task_saw_cameras_[task].store(0);
+    if (thread < 0 || thread >= 2) task_saw_cameras_[task].store(0);
+    task_runs_[task].fetch_add(1);
+  }
+
+  const std::vector<FeatureSet>& out_;
+  std::vector<std::pair<int, int>> pairs_;
+  std::atomic<int> camera_done_[kCameras] = {};
+  int seen_count_[kCameras] = {};
+  std::atomic<int> task_runs_[16] = {};
+  std::atomic<int> task_saw_cameras_[16] = {};
+};
+
+TEST(FeatureWorkers, FollowUpTasksRunOnceEachAfterBothOfTheirCameras) {
+  FeatureWorkers workers(options(), rig().sizes, 2);
+  std::vector<FeatureSet> out = makeSets();
+  RecordingFollowUp follow_up(out);
+  ASSERT_LE(follow_up.taskCount(), 16);
+  workers.setFollowUp(&follow_up);
+  bool present[kCameras] = {true, true, true, true, true};
+  for (int frame = 0; frame < 40; ++frame) {
+    present[frame % kCameras] = frame % 3 != 0;  // absent cameras still release their tasks
+    follow_up.reset();
+    workers.extract(rig().views.data(), present, out.data());
+    for (int c = 0; c < kCameras; ++c) {
+      ASSERT_EQ(follow_up.camera_done_[c].load(), 1) << "frame " << frame << " camera " << c;
+      ASSERT_EQ(follow_up.seen_count_[c], out[c].count) << "frame " << frame << " camera " << c;
+    }
+    for (int t = 0; t < follow_up.taskCount(); ++t) {
+      ASSERT_EQ(follow_up.task_runs_[t].load(), 1) << "frame " << frame << " task " << t;
+      ASSERT_EQ(follow_up.task_saw_cameras_[t].load(), 1) << "frame " << frame << " task " << t;
+    }
+  }
+  workers.setFollowUp(nullptr);  // and without it again
+  follow_up.reset();
+  workers.extract(rig().views.data(), present, out.data());
+  EXPECT_EQ(follow_up.task_runs_[0].load(), 0);
+}
+
+TEST(FeatureWorkers, FollowUpAllocatesNothingPerFrame) {
+  ASSERT_TRUE(alloc::available());
+  FeatureWorkers workers(options(), rig().sizes, 2);
+  std::vector<FeatureSet> out = makeSets();
+  RecordingFollowUp follow_up(out);
+  workers.setFollowUp(&follow_up);
+  const bool present[kCameras] = {true, true, false, true, true};
+  workers.extract(rig().views.data(), present, out.data());  // warm-up
+  const uint64_t before = alloc::totalCount();
+  for (int frame = 0; frame < 5; ++frame) workers.extract(rig().views.data(), present, out.data());
+  EXPECT_EQ(alloc::totalCount() - before, 0u);
 }
 
 TEST(FeatureWorkers, StartsAndStopsCleanly) {

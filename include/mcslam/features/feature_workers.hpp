@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "mcslam/features/orb_extractor.hpp"
@@ -21,6 +22,20 @@ namespace mcslam {
 
 struct ImageSize {
   int width = 0, height = 0;
+};
+
+// Work of a rig frame that depends on extracted cameras, run on the same threads so that it fills their idle
+// time (five cameras on two threads leave one thread idle during the last camera).
+class ExtractionFollowUp {
+ public:
+  virtual ~ExtractionFollowUp() = default;
+  // On the thread that extracted `camera` (absent or not), right after it.
+  virtual void afterCamera(int camera) = 0;
+  // The frame's tasks: task t starts once afterCamera() returned for both of its cameras; `thread` is the
+  // worker's index, so that concurrent tasks use distinct scratch.
+  virtual int taskCount() const = 0;
+  virtual std::pair<int, int> taskCameras(int task) const = 0;
+  virtual void runTask(int task, int thread) = 0;
 };
 
 class FeatureWorkers {
@@ -36,6 +51,10 @@ class FeatureWorkers {
   // An absent camera gets zero features. status (optional, one per camera) receives each result.
   void extract(const ImageView* images, const bool* present, FeatureSet* out, OrbStatus* status = nullptr);
 
+  // Runs `follow_up` (nullptr: none) within every following extract(); call between frames. Allocates its
+  // bookkeeping here, so a frame still allocates nothing.
+  void setFollowUp(ExtractionFollowUp* follow_up);
+
   int cameras() const { return static_cast<int>(max_sizes_.size()); }
   int threads() const { return static_cast<int>(threads_.size()); }
   // The extractor of worker thread `thread` (sized for the largest camera).
@@ -44,17 +63,24 @@ class FeatureWorkers {
  private:
   void run(int thread);
   void processCamera(int camera, OrbExtractor& extractor);
+  int takeReadyTask();  // -1 when no untaken task has both cameras done (caller holds mutex_)
 
   std::vector<ImageSize> max_sizes_;     // per camera: an image larger than this is refused
   std::vector<OrbExtractor> extractors_;  // per thread
   std::vector<std::thread> threads_;
 
   std::mutex mutex_;
-  std::condition_variable work_ready_, work_done_;
+  std::condition_variable work_ready_, work_done_, camera_done_;
   uint64_t frame_ = 0;     // incremented for each rig frame (guarded by mutex_)
   int next_camera_ = 0;    // next camera to take (guarded by mutex_)
-  int remaining_ = 0;      // cameras not finished yet (guarded by mutex_)
+  int remaining_ = 0;      // cameras and tasks not finished yet (guarded by mutex_)
   bool stopping_ = false;  // guarded by mutex_
+
+  ExtractionFollowUp* follow_up_ = nullptr;
+  int tasks_ = 0;                  // of the follow-up, per frame
+  int untaken_tasks_ = 0;          // guarded by mutex_
+  std::vector<uint8_t> done_;      // per camera, this frame (guarded by mutex_)
+  std::vector<uint8_t> taken_;     // per task, this frame (guarded by mutex_)
 
   // The current frame's arguments, valid while remaining_ > 0.
   const ImageView* images_ = nullptr;

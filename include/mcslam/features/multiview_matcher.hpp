@@ -4,6 +4,7 @@
 // the pairwise matches into tracks with at most one keypoint per camera, and triangulation from all
 // rays with depth, reprojection and uncertainty checks.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "mcslam/calib/rig.hpp"
@@ -55,14 +56,28 @@ struct MultiViewStats {
 
 class MultiViewMatcher {
  public:
-  // Everything is allocated here, for at most `max_features_per_camera` keypoints per camera.
+  // Everything is allocated here, for at most `max_features_per_camera` keypoints per camera and `threads`
+  // concurrent matchPair() calls (each thread gets its own scratch).
   MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, const MultiViewOptions& options,
-                   int max_features_per_camera);
+                   int max_features_per_camera, int threads = 1);
 
   // Computes bearings for every keypoint, then the multi-view features. No heap allocation. images (optional,
   // one per camera, valid during the call): the frame's images, for the subpixel alignment of the partners.
   void compute(FrameFeatures& frame, const ImageView* images = nullptr);
   const MultiViewStats& stats() const { return stats_; }
+
+  // compute() in steps, for callers that spread a frame over threads (the front-end runs the cameras and the
+  // pairs on its ORB workers): beginFrame(); prepareCamera() for every camera once its keypoints and `present`
+  // flag are final; matchPair() for every pair once both of its cameras are prepared, in any order and on any
+  // threads (distinct `thread` each); finishFrame(). Every pair writes its own slot and finishFrame() takes
+  // them in pair order, so the result does not depend on the order or the threads.
+  void beginFrame(FrameFeatures& frame, const ImageView* images = nullptr);
+  void prepareCamera(FrameFeatures& frame, int camera);
+  int pairCount() const { return static_cast<int>(overlap_.overlappingPairs().size()); }
+  std::pair<int, int> pairCameras(int pair) const { return overlap_.overlappingPairs()[static_cast<size_t>(pair)]; }
+  void matchPair(const FrameFeatures& frame, int pair, int thread);
+  void finishFrame(FrameFeatures& frame);
+  int threads() const { return static_cast<int>(scratch_.size()); }
 
  private:
   struct Match {
@@ -70,10 +85,12 @@ class MultiViewMatcher {
     int32_t kp_a, kp_b;
     int16_t distance;
   };
-  void computeBearings(FrameFeatures& f);
-  void bucketKeypoints(const FrameFeatures& f);
-  void matchPair(const FrameFeatures& f, int i, int j);
-  void noteForB(const FeatureSet& si, int b, int a, int d);
+  struct PairScratch;
+  void computeBearings(FrameFeatures& f, int camera);
+  void bucketKeypoints(const FrameFeatures& f, int camera);
+  int matchCameras(const FrameFeatures& f, int i, int j, PairScratch& s, Match* out) const;
+  void noteForB(const FeatureSet& si, int b, int a, int d, PairScratch& s) const;
+  void gatherMatches();
   void mergeTracks(FrameFeatures& f);
   void finishTrack(FrameFeatures& f, int first, int size);
   int alignToReference(FrameFeatures& f, int first, int size);
@@ -103,8 +120,8 @@ class MultiViewMatcher {
   std::vector<std::vector<Vec3>> bearing_grid_;
   std::vector<int> bearing_grid_cols_;
 
-  // Per pair: camera j's keypoints sorted by the angle of their epipolar plane about the baseline, and
-  // the candidate cells of the current cell of camera i marked with a stamp.
+  // Per matching thread: camera j's keypoints sorted by the angle of their epipolar plane about the baseline,
+  // the candidate cells of the current cell of camera i marked with a stamp, and the mutual-best bookkeeping.
   struct Candidate {                     // what the band scan reads, contiguous in plane-angle order
     float angle;
     int32_t b;
@@ -112,20 +129,28 @@ class MultiViewMatcher {
     int32_t octave;
     float d[3];                          // body-frame bearing
   };
-  std::vector<float> plane_angle_;       // per keypoint of camera j
-  std::vector<int32_t> sorted_b_;        // keypoints of j away from the epipole, by plane angle
-  std::vector<float> sorted_angle_;
-  std::vector<Candidate> sorted_candidates_;
-  std::vector<int32_t> near_epipole_b_;  // keypoints of j close to the baseline direction: checked one by one
-  std::vector<uint32_t> cell_stamp_;     // per cell of camera j
-  uint32_t stamp_ = 0;
+  struct PairScratch {
+    PairScratch(int capacity, int max_cells);
+    std::vector<float> plane_angle;       // per keypoint of camera j
+    std::vector<int32_t> sorted_b;        // keypoints of j away from the epipole, by plane angle
+    std::vector<float> sorted_angle;
+    std::vector<Candidate> sorted_candidates;
+    std::vector<int32_t> near_epipole_b;  // keypoints of j close to the baseline direction: checked one by one
+    std::vector<uint32_t> cell_stamp;     // per cell of camera j
+    uint32_t stamp = 0;
+    std::vector<int32_t> best_for_b;      // per keypoint of camera j: best keypoint of camera i
+    std::vector<int16_t> best_dist_for_b;
+    std::vector<int16_t> second_dist_for_b;  // ignoring copies of the best at other octaves
+    std::vector<int32_t> candidate_b;     // epipolar-consistent candidates of the current keypoint
+    std::vector<int16_t> candidate_dist;
+  };
+  std::vector<PairScratch> scratch_;
 
-  // Pairwise matches and their merge.
+  // Pairwise matches (pair p's in its slot of `capacity_` from p * capacity_, gathered to the front in pair
+  // order by finishFrame()) and their merge.
   std::vector<Match> matches_;
+  std::vector<int32_t> pair_matches_;    // per pair
   int match_count_ = 0;
-  std::vector<int32_t> best_for_b_;      // per keypoint of camera j: best keypoint of camera i
-  std::vector<int16_t> best_dist_for_b_;
-  std::vector<int16_t> second_dist_for_b_;  // ignoring copies of the best at other octaves
   std::vector<int32_t> parent_;          // union-find over (camera, keypoint) nodes
   std::vector<uint64_t> camera_mask_;    // per root: cameras already in the component
   std::vector<int32_t> order_;           // matches sorted by distance
@@ -143,8 +168,6 @@ class MultiViewMatcher {
   };
   std::vector<Member> members_obs_;
   const ImageView* images_ = nullptr;  // the current frame's, during compute()
-  std::vector<int32_t> candidate_b_;     // epipolar-consistent candidates of the current keypoint
-  std::vector<int16_t> candidate_dist_;
 };
 
 }  // namespace mcslam

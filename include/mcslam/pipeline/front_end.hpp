@@ -12,8 +12,8 @@
 namespace mcslam {
 
 struct FrontEndTiming {
-  double extraction_ms = 0;
-  double multiview_ms = 0;
+  double extraction_ms = 0;  // ORB on the workers, with the pairwise multi-view matching that fills their idle time
+  double multiview_ms = 0;   // the pairwise matches merged into tracks and triangulated
 };
 
 class FrontEnd {
@@ -31,11 +31,27 @@ class FrontEnd {
   int capacityPerCamera() const { return capacity_; }
 
  private:
+  // The multi-view matcher's per-camera preparation and camera pairs, as tasks of the ORB workers.
+  class MatchingTasks : public ExtractionFollowUp {
+   public:
+    explicit MatchingTasks(MultiViewMatcher& matcher) : matcher_(matcher) {}
+    void setFrame(FrameFeatures* frame) { frame_ = frame; }
+    void afterCamera(int camera) override { matcher_.prepareCamera(*frame_, camera); }
+    int taskCount() const override { return matcher_.pairCount(); }
+    std::pair<int, int> taskCameras(int task) const override { return matcher_.pairCameras(task); }
+    void runTask(int task, int thread) override { matcher_.matchPair(*frame_, task, thread); }
+
+   private:
+    MultiViewMatcher& matcher_;
+    FrameFeatures* frame_ = nullptr;
+  };
+
   const Rig& rig_;
   int capacity_;
   OverlapMap overlap_;
   FeatureWorkers workers_;
   MultiViewMatcher matcher_;
+  MatchingTasks matching_tasks_{matcher_};
   std::vector<ImageView> images_;
   std::unique_ptr<bool[]> present_;
   FrontEndTiming timing_;
