@@ -60,9 +60,14 @@ class PoseRefiner {
   int capacity() const { return static_cast<int>(inliers_.size()); }
 
  private:
-  double robustCost(std::span<const PoseObservation> obs, const SE3& T_b_w, bool robust) const;
-  // Marks each observation as inlier or not at T_b_w; returns the inlier count.
-  int classify(std::span<const PoseObservation> obs, const SE3& T_b_w);
+  struct Pass {
+    double cost = 0;     // robust or plain, over the inliers
+    double squares = 0;  // sum of (error / sigma)^2 over the linearized inliers
+    Mat6 H = Mat6::Zero();
+    Vec6 g = Vec6::Zero();
+    int inliers = 0;  // counted when the pass reclassifies
+  };
+  Pass evaluate(std::span<const PoseObservation> obs, const SE3& T_b_w, bool robust, bool reclassify, bool linearize);
 
   RigProjector rig_;
   PoseRefinementOptions options_;
