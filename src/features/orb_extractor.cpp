@@ -133,7 +133,7 @@ void OrbExtractor::Impl::detect(const Plane& image, const Rect& region) {
 
   corners.clear();
   scoreRect(image, scores, region, options.fast_threshold);
-  collectLocalMaxima(scores, region, corners);
+  collectLocalMaxima(scores, region, corners, options.use_simd);
   if (options.min_fast_threshold >= options.fast_threshold) return;
 
   // Cells where the threshold found nothing try the lower one (ORB-SLAM's fallback), so weakly
@@ -145,7 +145,7 @@ void OrbExtractor::Impl::detect(const Plane& image, const Rect& region) {
     if (per_cell[static_cast<size_t>(c)] != 0) continue;
     const Rect cell = grid.cellRect(c);
     scoreRect(image, scores, cell, options.min_fast_threshold);
-    collectLocalMaxima(scores, cell, corners);
+    collectLocalMaxima(scores, cell, corners, options.use_simd);
   }
 }
 

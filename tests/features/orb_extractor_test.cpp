@@ -8,6 +8,7 @@
 #include "mcslam/core/error.hpp"
 #include "mcslam/features/orb_extractor.hpp"
 #include "orb_fast.hpp"
+#include "orb_grid.hpp"
 #include "orb_test_images.hpp"
 
 namespace mcslam {
@@ -80,6 +81,59 @@ TEST(OrbFast, ScoresMatchTheDefinitionOnBothKernels) {
     }
   }
   EXPECT_GT(corners_seen, 1000);  // the frame has corners at all three thresholds
+}
+
+// The 3x3 suppression against its definition (ties go to the later pixel in raster order), on both kernels,
+// on sparse random score maps with many ties, for rects of every alignment and a capacity that runs out.
+TEST(OrbFast, LocalMaximaMatchTheDefinitionOnBothKernels) {
+  constexpr int kW = 97, kH = 41, kStride = 128;
+  std::vector<uint8_t> map(static_cast<size_t>(kStride) * (kH + 2) + 64, 0);
+  uint32_t state = 12345;
+  auto next = [&] { return state = state * 1664525u + 1013904223u; };
+  int total = 0;
+  for (int round = 0; round < 60; ++round) {
+    std::fill(map.begin(), map.end(), 0);
+    for (int y = 1; y <= kH; ++y) {
+      for (int x = 1; x <= kW; ++x) {
+        if (next() % 3 == 0) map[static_cast<size_t>(y) * kStride + x] = static_cast<uint8_t>(1 + (next() >> 24) % 4);
+      }
+    }
+    const orb_detail::ConstPlane plane{map.data(), kW + 2, kH + 2, kStride};
+    const orb_detail::Rect rect{1 + round % 17, 1 + round % 5, kW + 1 - round % 13, kH + 1 - round % 3};
+    // The definition, with the frame outside the rect read as it is (as the extractor's fallback cells do).
+    std::vector<orb_detail::Corner> expected;
+    for (int y = rect.y0; y < rect.y1; ++y) {
+      for (int x = rect.x0; x < rect.x1; ++x) {
+        auto at = [&](int dx, int dy) { return int(map[static_cast<size_t>(y + dy) * kStride + x + dx]); };
+        const int s = at(0, 0);
+        if (s == 0) continue;
+        bool is_max = true;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            if (dx == 0 && dy == 0) continue;
+            const bool earlier = dy < 0 || (dy == 0 && dx < 0);
+            is_max = is_max && (earlier ? s >= at(dx, dy) : s > at(dx, dy));
+          }
+        }
+        if (is_max) expected.push_back({x, y, static_cast<float>(s)});
+      }
+    }
+    const size_t capacity = round % 4 == 3 ? expected.size() / 2 : expected.size() + 5;
+    for (const bool simd : {false, true}) {
+      std::vector<orb_detail::Corner> got;
+      got.reserve(capacity);
+      const size_t reserved = got.capacity();
+      orb_detail::collectLocalMaxima(plane, rect, got, simd);
+      ASSERT_EQ(got.size(), std::min(expected.size(), reserved)) << "round " << round << " simd " << simd;
+      for (size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i].x, expected[i].x) << "round " << round << " simd " << simd;
+        ASSERT_EQ(got[i].y, expected[i].y);
+        ASSERT_EQ(got[i].score, expected[i].score);
+      }
+    }
+    total += static_cast<int>(expected.size());
+  }
+  EXPECT_GT(total, 1000);
 }
 
 TEST(OrbExtractor, SimdAndScalarKernelsGiveIdenticalFeatures) {
