@@ -117,7 +117,7 @@ struct OrbExtractor::Impl {
 };
 
 void OrbExtractor::Impl::scoreRect(const Plane& image, const Plane& scores, const Rect& r, int threshold) const {
-  const FastBackend backend = options.use_simd ? FastBackend::kNative : FastBackend::kScalar;
+  const FastBackend backend = options.use_simd ? FastBackend::kWide : FastBackend::kScalar;
   for (int y = r.y0; y < r.y1; ++y)
     fastScoreRow(image.data, image.stride, y, r.x0, r.x1, threshold, scores.row(y) + r.x0, backend);
 }
@@ -163,7 +163,7 @@ int OrbExtractor::Impl::extractLevel(int level, const Plane& image, int budget, 
 
   // Orientation on the level itself, the descriptor on its smoothed copy.
   const Plane smooth = plane(smoothed, image.width, image.height);
-  gaussianBlur7(image, smooth, plane(blur_tmp, image.width, image.height));
+  gaussianBlur7(image, smooth, plane(blur_tmp, image.width, image.height), options.use_simd);
   const float scale = scales.scale[static_cast<size_t>(level)];
   for (int i = 0; i < n; ++i) {
     const Corner& c = chosen[static_cast<size_t>(i)];

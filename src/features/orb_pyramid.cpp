@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "orb_blur_kernel.hpp"
+#include "orb_fast.hpp"
 #include "orb_simd.hpp"
 
 namespace mcslam::orb_detail {
@@ -73,50 +75,14 @@ void downscale(const ConstPlane& src, const Plane& dst, float ratio, const Downs
   }
 }
 
-namespace {
-
-// round(256 * exp(-i^2 / 8) / sum) for i = 0..3 (sigma 2), centre adjusted so the taps sum to 256.
-constexpr uint16_t kTap0 = 54, kTap1 = 49, kTap2 = 34, kTap3 = 18;
-static_assert(kTap0 + 2 * (kTap1 + kTap2 + kTap3) == 256);
-
-inline uint8_t blurTaps(int c, int a1, int b1, int a2, int b2, int a3, int b3) {
-  const int v = kTap0 * c + kTap1 * (a1 + b1) + kTap2 * (a2 + b2) + kTap3 * (a3 + b3) + 128;
-  return static_cast<uint8_t>(v >> 8);
-}
-
-}  // namespace
-
-void gaussianBlur7(const ConstPlane& src, const Plane& dst, const Plane& tmp) {
-  const int w = src.width, h = src.height;
-  // Horizontal pass into tmp: the interior in 16-bit lanes (the sum fits), the 3-pixel borders clamped.
-  for (int y = 0; y < h; ++y) {
-    const uint8_t* s = src.row(y);
-    uint8_t* t = tmp.row(y);
-    auto at = [&](int x) { return static_cast<int>(s[std::clamp(x, 0, w - 1)]); };
-    const int interior_end = std::max(w - 3, 3);
-    for (int x = 0; x < std::min(3, w); ++x)
-      t[x] = blurTaps(at(x), at(x - 1), at(x + 1), at(x - 2), at(x + 2), at(x - 3), at(x + 3));
-    for (int x = 3; x < interior_end; ++x) {
-      const uint16_t v = static_cast<uint16_t>(
-          kTap0 * s[x] + kTap1 * static_cast<uint16_t>(s[x - 1] + s[x + 1]) +
-          kTap2 * static_cast<uint16_t>(s[x - 2] + s[x + 2]) + kTap3 * static_cast<uint16_t>(s[x - 3] + s[x + 3]) + 128);
-      t[x] = static_cast<uint8_t>(v >> 8);
-    }
-    for (int x = std::max(interior_end, 3); x < w; ++x)
-      t[x] = blurTaps(at(x), at(x - 1), at(x + 1), at(x - 2), at(x + 2), at(x - 3), at(x + 3));
+void gaussianBlur7(const ConstPlane& src, const Plane& dst, const Plane& tmp, bool use_simd) {
+#if defined(MCSLAM_ORB_HAVE_AVX2_UNIT)
+  if (use_simd && fastHasWideSimd()) {
+    return gaussianBlur7Avx2(src.data, src.stride, dst.data, dst.stride, tmp.data, tmp.stride, src.width, src.height);
   }
-  // Vertical pass into dst, rows clamped at the borders.
-  for (int y = 0; y < h; ++y) {
-    const uint8_t* r[7];
-    for (int k = 0; k < 7; ++k) r[k] = tmp.row(std::clamp(y + k - 3, 0, h - 1));
-    uint8_t* d = dst.row(y);
-    for (int x = 0; x < w; ++x) {
-      const uint16_t v = static_cast<uint16_t>(
-          kTap0 * r[3][x] + kTap1 * static_cast<uint16_t>(r[2][x] + r[4][x]) +
-          kTap2 * static_cast<uint16_t>(r[1][x] + r[5][x]) + kTap3 * static_cast<uint16_t>(r[0][x] + r[6][x]) + 128);
-      d[x] = static_cast<uint8_t>(v >> 8);
-    }
-  }
+#endif
+  (void)use_simd;
+  blur7(src.data, src.stride, dst.data, dst.stride, tmp.data, tmp.stride, src.width, src.height);
 }
 
 }  // namespace mcslam::orb_detail

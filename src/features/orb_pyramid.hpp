@@ -32,6 +32,7 @@ struct DownscaleScratch {
 void downscale(const ConstPlane& src, const Plane& dst, float ratio, const DownscaleScratch& scratch, bool use_simd);
 
 // 7x7 Gaussian, sigma 2 (the smoothing rBRIEF's tests assume), borders replicated. tmp: src-sized.
-void gaussianBlur7(const ConstPlane& src, const Plane& dst, const Plane& tmp);
+// use_simd: the AVX2 build where the CPU has it (identical results).
+void gaussianBlur7(const ConstPlane& src, const Plane& dst, const Plane& tmp, bool use_simd = true);
 
 }  // namespace mcslam::orb_detail

@@ -17,6 +17,7 @@
 namespace mcslam::orb_detail {
 
 struct ScalarU8x16 {
+  static constexpr int kLanes = 16;
   uint8_t v[16];
 
   static ScalarU8x16 load(const uint8_t* p) {
@@ -62,6 +63,7 @@ struct ScalarU8x16 {
 
 #if defined(MCSLAM_ORB_HAVE_SSE2)
 struct NativeU8x16 {
+  static constexpr int kLanes = 16;
   __m128i v;
 
   static NativeU8x16 load(const uint8_t* p) {
@@ -84,6 +86,7 @@ struct NativeU8x16 {
 #define MCSLAM_ORB_HAVE_NATIVE 1
 #elif defined(MCSLAM_ORB_HAVE_NEON)
 struct NativeU8x16 {
+  static constexpr int kLanes = 16;
   uint8x16_t v;
 
   static NativeU8x16 load(const uint8_t* p) { return {vld1q_u8(p)}; }

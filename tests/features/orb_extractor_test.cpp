@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "mcslam/core/error.hpp"
@@ -59,13 +60,16 @@ int bruteForceFastScore(const Image& img, int x, int y) {
   return best;
 }
 
-TEST(OrbFast, ScoresMatchTheDefinitionOnBothKernels) {
+TEST(OrbFast, ScoresMatchTheDefinitionOnEveryKernel) {
+  // kWide is the AVX2 kernel where this CPU has it (else it runs kNative again): say which one was checked.
+  std::printf("FAST kernels checked: scalar, %s, %s\n", orb_detail::fastHasNativeSimd() ? "16-lane SIMD" : "scalar",
+              orb_detail::fastHasWideSimd() ? "32-lane AVX2" : "16-lane (no AVX2 here)");
   const Image& img = frame640();
   std::vector<uint8_t> row(img.width() + 16);
   int corners_seen = 0;
   for (int threshold : {7, 20, 40}) {
     for (int y = 3; y < 200; ++y) {
-      for (auto backend : {orb_detail::FastBackend::kScalar, orb_detail::FastBackend::kNative}) {
+      for (auto backend : {orb_detail::FastBackend::kScalar, orb_detail::FastBackend::kNative, orb_detail::FastBackend::kWide}) {
         // An odd segment end exercises the partial last group.
         const int x0 = 3, x1 = img.width() - 3 - (y % 7);
         const int n = orb_detail::fastScoreRow(img.data(), img.width(), y, x0, x1, threshold, row.data(), backend);
