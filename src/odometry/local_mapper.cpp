@@ -139,7 +139,6 @@ int LocalMapper::insertKeyframe(const FrameFeatures& frame, const FrameMatches* 
   kf.T_w_b = T_w_b;
   kf.t = frame.t;
   kf.frame_index = frame_index;
-  for (int c = 0; c < frame.cameras(); ++c) kf.grids[c].build(kf.features.sets[c]);
 
   if (matches) {
     for (int c = 0; c < frame.cameras(); ++c) {

@@ -12,7 +12,6 @@ Map::Map(const Rig& rig, int max_features_per_camera, int max_keyframes, int max
   for (Keyframe& kf : keyframes_) {
     kf.features.allocate(cameras, max_features_per_camera);
     kf.landmark_of.assign(cameras, std::vector<int32_t>(max_features_per_camera, -1));
-    for (const RigCamera& c : rig.cameras) kf.grids.emplace_back(c.model.width(), c.model.height(), 24, max_features_per_camera);
   }
   clear();
 }

@@ -86,17 +86,16 @@ int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T
       const double r2 = radius * radius;
       const FeatureSet& set = frame.sets[c];
       int best = 257, second = 257, best_kp = -1, best_octave = 0, second_octave = 0;
-      grids_[c].forEachNear(uv.x(), uv.y(), radius, [&](int k) {
-        const Keypoint& kp = set.keypoints[k];
+      grids_[c].forEachNear(uv.x(), uv.y(), radius, [&](const KeypointGrid::Entry& kp) {
         if (p.check_scale && l.max_distance > 0 && (kp.octave < predicted - 1 || kp.octave > predicted + 1)) return;
         const double dx = kp.x - uv.x(), dy = kp.y - uv.y();
         if (dx * dx + dy * dy > r2) return;
-        const int d = hammingDistance(l.descriptor, set.descriptors[k]);
+        const int d = hammingDistance(l.descriptor, set.descriptors[kp.index]);
         if (d < best) {
           second = best;
           second_octave = best_octave;
           best = d;
-          best_kp = k;
+          best_kp = kp.index;
           best_octave = kp.octave;
         } else if (d < second) {
           second = d;

@@ -7,7 +7,6 @@
 
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/features/frame_features.hpp"
-#include "mcslam/odometry/keypoint_grid.hpp"
 
 namespace mcslam {
 
@@ -46,7 +45,6 @@ struct Keyframe {
   SE3 T_w_b;
   FrameFeatures features;
   std::vector<std::vector<int32_t>> landmark_of;  // per camera per keypoint: landmark slot or -1
-  std::vector<KeypointGrid> grids;                // per camera, for epipolar searches into this keyframe
   bool in_backend = false;
 };
 
