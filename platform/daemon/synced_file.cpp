@@ -39,8 +39,8 @@ bool writeFileSynced(const std::string& path, const std::string& text, std::stri
   ::close(fd);
   if (::rename(tmp.c_str(), path.c_str()) != 0) return fail(error, "cannot rename to", path);
   // The rename itself is durable only once the folder is synced.
-  std::string dir = std::filesystem::path(path).parent_path().string();
-  if (dir.empty()) dir = ".";
+  const std::string parent = std::filesystem::path(path).parent_path().string();
+  const std::string dir = parent.empty() ? std::string(1, '.') : parent;
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dfd < 0) return fail(error, "cannot open folder", dir);
   const bool synced = ::fsync(dfd) == 0;

@@ -104,7 +104,7 @@ void OverlapMap::computePair(const Rig& rig, int i, int j) {
         Vec3 bearing;
         if (!mi.unproject(Vec2(px, py), bearing)) continue;
         bool have_prev = false;
-        Vec2 prev;
+        Vec2 prev = Vec2::Zero();  // (read only when have_prev)
         for (int k = 0; k < o.depth_samples; ++k) {
           const double inv = 1.0 / o.min_depth + (1.0 / o.max_depth - 1.0 / o.min_depth) * k / (o.depth_samples - 1);
           const Vec3 pj = T_j_i * (bearing / inv);

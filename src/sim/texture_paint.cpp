@@ -209,7 +209,10 @@ std::string randomHeading(Rng& rng) {
   std::string s;
   const int len = rng.integer(3, 9);
   for (int i = 0; i < len; ++i) s += static_cast<char>('A' + rng.integer(0, 25));
-  if (rng.chance(0.4)) s += " " + std::to_string(rng.integer(1, 999));
+  if (rng.chance(0.4)) {
+    s += ' ';
+    s += std::to_string(rng.integer(1, 999));
+  }
   return s;
 }
 
