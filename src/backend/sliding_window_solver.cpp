@@ -216,6 +216,24 @@ Status SlidingWindowSolver::setLandmarkPosition(int64_t id, const Vec3& p_w) {
   return Status::Ok;
 }
 
+Status SlidingWindowSolver::setExtrinsic(int camera, const SE3& T_b_c) {
+  if (camera < 0 || camera >= impl_->window.numCameras() || !impl_->window.extrinsics[camera].variable) {
+    return Status::InvalidCamera;
+  }
+  if (!T_b_c.R.allFinite() || !T_b_c.t.allFinite()) return Status::InvalidValue;
+  ExtrinsicState& e = impl_->window.extrinsics[camera];
+  e.T = T_b_c;
+  e.T.normalize();
+  if (e.in_prior) {
+    // The marginalization prior is on d about its fixed linearization point: express the estimate there.
+    e.d = (e.T_lin.inverse() * e.T).log();
+  } else {
+    e.T_lin = e.T;
+    e.d.setZero();
+  }
+  return Status::Ok;
+}
+
 SolveSummary SlidingWindowSolver::solve(int max_iterations) { return impl_->solve(max_iterations); }
 std::span<const ObservationKey> SlidingWindowSolver::outliers() const { return impl_->outliers; }
 

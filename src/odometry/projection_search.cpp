@@ -61,13 +61,14 @@ int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T
   for (int c = 0; c < cams; ++c) T_c_w_[c] = (T_w_b * rig_.T_b_c(c)).inverse();
   const float log_scale = std::log(p.scale_factor);
   const OctaveScales scales(p.scale_factor);
+  const int c_begin = p.camera >= 0 ? p.camera : 0, c_end = p.camera >= 0 ? std::min(p.camera + 1, cams) : cams;
   int made = 0;
   for (int i = 0; i < n; ++i) {
     const int lm = slots[i];
     Landmark& l = map.landmark(lm);
     if (!l.alive) continue;
     bool visible = false;
-    for (int c = 0; c < cams; ++c) {
+    for (int c = c_begin; c < c_end; ++c) {
       if (!frame.present[c] || matches.keypointOf(lm, c) >= 0) continue;
       const Vec3 p_c = T_c_w_[c] * l.p_w;
       if (p_c.z() < cos_field_[c] * p_c.norm()) continue;  // outside the camera's field of view

@@ -108,6 +108,9 @@ class SlidingWindowSolver {
   Status setKeyframeFixed(int64_t id, bool fixed);
   Status setKeyframePose(int64_t id, const SE3& T_w_b);
   Status setLandmarkPosition(int64_t id, const Vec3& p_w);
+  // A new current estimate of a refined camera's extrinsic T_b_c (from outside, e.g. a per-camera check); the
+  // calibration stays the prior's mean. InvalidCamera when that extrinsic is not refined.
+  Status setExtrinsic(int camera, const SE3& T_b_c);
 
   // ---- optimization ----
   SolveSummary solve(int max_iterations);

@@ -46,6 +46,8 @@ class RigProjector {
   // n times this apart cannot project closer than n pixels, which lets RANSAC reject a point
   // without the full projection.
   double maxRadiansPerPixel(int cam) const { return max_rad_per_px_[cam]; }
+  // A new estimate of camera `cam`'s extrinsic (online calibration).
+  void setExtrinsic(int cam, const SE3& T_b_c) { T_c_b_[cam] = T_b_c.inverse(); }
 
   // Reprojection residual r = project(T_c_b * T_b_w * point_w) - pixel, in pixels. With J, also
   // dr/d(delta) for the body pose perturbed on the right, T_w_b * exp(delta), delta = [rho; phi].

@@ -59,6 +59,10 @@ class AbsolutePoseRansac {
   void reseed(uint64_t seed) { random_.seed(seed); }
   const AbsolutePoseRansacOptions& options() const { return options_; }
   int capacity() const { return static_cast<int>(inliers_.size()); }
+  void setExtrinsic(int cam, const SE3& T_b_c) {
+    rig_.setExtrinsic(cam, T_b_c);
+    refiner_.setExtrinsic(cam, T_b_c);
+  }
 
  private:
   // MSAC cost of a hypothesis; stops early (returning a value >= bail_out) once it exceeds bail_out.

@@ -58,6 +58,7 @@ class PoseRefiner {
   const PoseRefinementOptions& options() const { return options_; }
   void setOptions(const PoseRefinementOptions& options) { options_ = options; }
   int capacity() const { return static_cast<int>(inliers_.size()); }
+  void setExtrinsic(int cam, const SE3& T_b_c) { rig_.setExtrinsic(cam, T_b_c); }
 
  private:
   struct Pass {

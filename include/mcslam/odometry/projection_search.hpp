@@ -40,6 +40,7 @@ struct ProjectionSearchParams {
   float scale_factor = 1.2f;
   int levels = 8;
   bool check_scale = true;  // keypoint octave near the one predicted from the distance
+  int camera = -1;          // search this camera only (-1: every camera)
 };
 
 class ProjectionSearch {
