@@ -1,5 +1,7 @@
 #include "mcslam/backend/sliding_window_solver.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <string>
 
 #include "marginalizer.hpp"
@@ -67,6 +69,10 @@ struct SlidingWindowSolver::Impl {
 
   SolveSummary solve(int max_iterations);
   void classifyOutliers();
+  // What the marginalization prior knew of this extrinsic was gathered at a linearization point now judged wrong:
+  // the extrinsic is marginalized out of the prior (Schur complement: what it told about the others stays) and
+  // unlinked, so it is linearized afresh. Rare (an outside re-estimation): the temporaries may allocate.
+  void forgetExtrinsicInPrior(int camera);
 
   SolverOptions options;
   WindowStorage window;
@@ -174,6 +180,27 @@ void SlidingWindowSolver::Impl::classifyOutliers() {
   }
 }
 
+void SlidingWindowSolver::Impl::forgetExtrinsicInPrior(int camera) {
+  int v = 0;
+  for (int c = 0; c < camera; ++c) v += window.extrinsics[c].variable ? 1 : 0;
+  const int k = 6 * v;
+  // Pseudo-inverse of the camera's block (it may hold information in some directions only).
+  const Eigen::SelfAdjointEigenSolver<Mat6> eig(prior.H.block<6, 6>(k, k));
+  const double floor = 1e-12 * std::max(1.0, eig.eigenvalues().cwiseAbs().maxCoeff());
+  Vec6 inv = Vec6::Zero();
+  for (int i = 0; i < 6; ++i) inv(i) = eig.eigenvalues()(i) > floor ? 1.0 / eig.eigenvalues()(i) : 0.0;
+  const Mat6 P = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  const Eigen::MatrixXd Hc = prior.H.middleCols<6>(k);  // column block of the camera
+  const Vec6 bc = prior.b.segment<6>(k);
+  prior.c -= 0.5 * bc.dot(P * bc);
+  prior.b.noalias() -= Hc * (P * bc);
+  prior.H.noalias() -= Hc * P * Hc.transpose();
+  prior.H.middleCols<6>(k).setZero();
+  prior.H.middleRows<6>(k).setZero();
+  prior.b.segment<6>(k).setZero();
+  window.extrinsics[camera].in_prior = false;
+}
+
 SlidingWindowSolver::SlidingWindowSolver(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& options)
     : impl_(std::make_unique<Impl>(rig, capacity, options)) {}
 SlidingWindowSolver::~SlidingWindowSolver() = default;
@@ -216,21 +243,18 @@ Status SlidingWindowSolver::setLandmarkPosition(int64_t id, const Vec3& p_w) {
   return Status::Ok;
 }
 
-Status SlidingWindowSolver::setExtrinsic(int camera, const SE3& T_b_c) {
+Status SlidingWindowSolver::setExtrinsic(int camera, const SE3& T_b_c, bool keep_calibration_prior) {
   if (camera < 0 || camera >= impl_->window.numCameras() || !impl_->window.extrinsics[camera].variable) {
     return Status::InvalidCamera;
   }
   if (!T_b_c.R.allFinite() || !T_b_c.t.allFinite()) return Status::InvalidValue;
   ExtrinsicState& e = impl_->window.extrinsics[camera];
+  if (e.in_prior) impl_->forgetExtrinsicInPrior(camera);
   e.T = T_b_c;
   e.T.normalize();
-  if (e.in_prior) {
-    // The marginalization prior is on d about its fixed linearization point: express the estimate there.
-    e.d = (e.T_lin.inverse() * e.T).log();
-  } else {
-    e.T_lin = e.T;
-    e.d.setZero();
-  }
+  e.T_lin = e.T;
+  e.d.setZero();
+  e.calibration_prior = e.calibration_prior && keep_calibration_prior;
   return Status::Ok;
 }
 
@@ -273,6 +297,9 @@ bool SlidingWindowSolver::isFull() const {
   return impl_->window.num_keyframes >= impl_->window.capacity().max_keyframes;
 }
 const Eigen::MatrixXd& SlidingWindowSolver::priorInformation() const { return impl_->prior.H; }
+bool SlidingWindowSolver::hasCalibrationPrior(int camera) const {
+  return impl_->window.extrinsics.at(camera).variable && impl_->window.extrinsics.at(camera).calibration_prior;
+}
 bool SlidingWindowSolver::extrinsicInPrior(int camera) const { return impl_->window.extrinsics.at(camera).in_prior; }
 size_t SlidingWindowSolver::cholmodArenaPeakBytes() const { return impl_->reduced.arena().peakBytes(); }
 size_t SlidingWindowSolver::cholmodArenaOverflows() const { return impl_->reduced.arena().overflows(); }

@@ -182,6 +182,11 @@ void WindowLinearization::linearize(const WindowStorage& window, const Marginali
   for (int c = 0; c < num_cameras_; ++c) {
     const ExtrinsicState& e = window.extrinsics[c];
     if (!e.variable) continue;
+    if (!e.calibration_prior) {
+      prior_r_[c].setZero();
+      prior_J_[c].setZero();
+      continue;
+    }
     prior_r_[c] = extrinsicPriorResidual(e.T_calib, e.T, options_.extrinsic_prior, use_fej_[c] ? &e.T_lin : nullptr,
                                          &prior_J_[c]);
   }
@@ -194,7 +199,7 @@ double WindowLinearization::priorCost(const WindowStorage& window, const Margina
   double cost = 0;
   for (int c = 0; c < num_cameras_; ++c) {
     const ExtrinsicState& e = window.extrinsics[c];
-    if (!e.variable) continue;
+    if (!e.variable || !e.calibration_prior) continue;
     const SE3& T = trial ? ext_trial_[c] : e.T;
     cost += 0.5 * extrinsicPriorResidual(e.T_calib, T, options_.extrinsic_prior).squaredNorm();
   }

@@ -46,6 +46,7 @@ struct ExtrinsicState {
   SE3 T;
   bool variable = false;  // refined (not the reference camera, refinement on)
   bool in_prior = false;  // linked to the marginalization prior
+  bool calibration_prior = true;  // false once an outside estimate showed the calibration wrong
 };
 
 // Free slots are kept on a stack, so slots are reused without allocating.

@@ -108,9 +108,13 @@ class SlidingWindowSolver {
   Status setKeyframeFixed(int64_t id, bool fixed);
   Status setKeyframePose(int64_t id, const SE3& T_w_b);
   Status setLandmarkPosition(int64_t id, const Vec3& p_w);
-  // A new current estimate of a refined camera's extrinsic T_b_c (from outside, e.g. a per-camera check); the
-  // calibration stays the prior's mean. InvalidCamera when that extrinsic is not refined.
-  Status setExtrinsic(int camera, const SE3& T_b_c);
+  // A new current estimate of a refined camera's extrinsic T_b_c from outside (e.g. a per-camera check). The
+  // marginalization prior forgets that extrinsic (it was linearized at the old estimate) and keeps what it knows
+  // of the others. Unless keep_calibration_prior, the camera's calibration prior is dropped: the estimate says
+  // the calibration is wrong, and with every extrinsic free the rig's scale is set by the translation priors
+  // alone, so a wrong one would bias it. InvalidCamera when that extrinsic is not refined.
+  Status setExtrinsic(int camera, const SE3& T_b_c, bool keep_calibration_prior = false);
+  bool hasCalibrationPrior(int camera) const;
 
   // ---- optimization ----
   SolveSummary solve(int max_iterations);
