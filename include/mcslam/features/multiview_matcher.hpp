@@ -65,6 +65,8 @@ class MultiViewMatcher {
   // one per camera, valid during the call): the frame's images, for the subpixel alignment of the partners.
   void compute(FrameFeatures& frame, const ImageView* images = nullptr);
   const MultiViewStats& stats() const { return stats_; }
+  // A new estimate of camera `cam`'s extrinsic (online refinement), for the next compute().
+  void setBodyFromCamera(int cam, const SE3& T_b_c) { rig_.cameras[cam].T_b_c = T_b_c; }
 
   // compute() in steps, for callers that spread a frame over threads (the front-end runs the cameras and the
   // pairs on its ORB workers): beginFrame(); prepareCamera() for every camera once its keypoints and `present`
@@ -99,7 +101,7 @@ class MultiViewMatcher {
   bool bearingOf(int cam, const Vec2& uv, Vec3& bearing) const;
   int find(int node);
 
-  const Rig& rig_;
+  Rig rig_;  // a copy: setBodyFromCamera() moves its extrinsics
   const OverlapMap& overlap_;
   MultiViewOptions options_;
   int capacity_;

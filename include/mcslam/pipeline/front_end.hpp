@@ -29,6 +29,8 @@ class FrontEnd {
   const MultiViewStats& multiViewStats() const { return matcher_.stats(); }
   uint64_t rejectedImages() const { return rejected_images_; }
   int capacityPerCamera() const { return capacity_; }
+  // The multi-view features of the next frames use this extrinsic for camera `cam` (online refinement).
+  void setBodyFromCamera(int cam, const SE3& T_b_c) { matcher_.setBodyFromCamera(cam, T_b_c); }
 
  private:
   // The multi-view matcher's per-camera preparation and camera pairs, as tasks of the ORB workers.
