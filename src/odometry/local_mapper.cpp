@@ -34,12 +34,14 @@ backend::SolverOptions solverOptions(const OdometryOptions& o, bool monocular) {
 
 LocalMapper::LocalMapper(const Rig& rig, const OdometryOptions& options, Map& map, int max_features_per_camera)
     : rig_(rig),
+      calibration_(rig),
       options_(options),
       map_(map),
       band_index_(max_features_per_camera, options.levels),
       capacity_(max_features_per_camera),
       monocular_(rig.size() == 1) {
   const int cams = rig.size();
+  calibration_dropped_.assign(cams, 0);
   touched_.resize(map.landmarkCapacity());
   touched_flag_.assign(map.landmarkCapacity(), 0);
   for (const RigCamera& c : rig.cameras) half_fov_.push_back(c.model.imageHalfAngle());
@@ -66,12 +68,14 @@ void LocalMapper::reset() {
   if (worker_) worker_->wait();
   solving_ = false;  // the window is dropped with the map: its last result does not matter
   if (solver_) {
-    // A fresh window (the old one's keyframes and landmarks are gone with the map). This allocates:
-    // it happens only when tracking was lost, never per frame.
-    const Rig refined = solver_->refinedRig();
+    // A fresh window (the old one's keyframes and landmarks are gone with the map), on the same prior, starting
+    // from the current extrinsics. This allocates: it happens only when tracking was lost, never per frame.
     solver_.reset();
-    solver_ = std::make_unique<backend::SlidingWindowSolver>(refined, windowCapacity(options_, map_, rig_.size(), capacity_),
+    solver_ = std::make_unique<backend::SlidingWindowSolver>(calibration_, windowCapacity(options_, map_, rig_.size(), capacity_),
                                                              solverOptions(options_, monocular_));
+    for (int c = 0; c < rig_.size(); ++c) {  // refused where not refined
+      solver_->setExtrinsic(c, rig_.T_b_c(c), !calibration_dropped_[c]);
+    }
   }
   std::fill(touched_flag_.begin(), touched_flag_.end(), 0);
   touched_count_ = 0;
@@ -80,6 +84,14 @@ void LocalMapper::reset() {
 Rig LocalMapper::refinedRig() const {
   if (worker_) worker_->wait();
   return solver_ ? solver_->refinedRig() : rig_;
+}
+
+const SE3& LocalMapper::extrinsic(int cam) const { return solver_ ? solver_->extrinsic(cam) : rig_.T_b_c(cam); }
+
+bool LocalMapper::setExtrinsic(int cam, const SE3& T_b_c) {
+  if (!solver_ || solving_ || solver_->setExtrinsic(cam, T_b_c) != backend::Status::Ok) return false;
+  calibration_dropped_[cam] = 1;
+  return true;
 }
 
 int LocalMapper::keyframeSlotOfId(int64_t id) const {

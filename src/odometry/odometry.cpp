@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "extrinsic_check.hpp"
 #include "mcslam/odometry/initializer.hpp"
 #include "mcslam/odometry/local_mapper.hpp"
 
@@ -46,6 +47,10 @@ Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_featu
   matches_.allocate(cams, max_features_per_camera, options.max_landmarks);
   initializer_ = std::make_unique<Initializer>(rig_, options_, max_features_per_camera);
   mapper_ = std::make_unique<LocalMapper>(rig_, options_, map_, max_features_per_camera);
+  if (options.backend && options.refine_extrinsics && cams > 1) {
+    extrinsic_check_ = std::make_unique<ExtrinsicCheck>(rig_, options_, max_features_per_camera);
+  }
+  reestimated_.assign(cams, 0);
   observations_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
   observation_refs_.resize(observations_.size());
   last_tracked_.resize(options.max_landmarks);
@@ -62,9 +67,16 @@ void Odometry::resetMap() {
   map_.clear();
   mapper_->reset();
   initializer_->reset();
+  if (extrinsic_check_) extrinsic_check_->reset();
   last_tracked_count_ = 0;
   last_coarse_inliers_ = 0;
   have_velocity_ = false;
+}
+
+void Odometry::useExtrinsic(int cam, const SE3& T_b_c) {
+  rig_.cameras[cam].T_b_c = T_b_c;  // the map, projection search, mapper and initializer read it through rig_
+  ransac_.setExtrinsic(cam, T_b_c);
+  refiner_.setExtrinsic(cam, T_b_c);
 }
 
 void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
@@ -105,6 +117,17 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
   }
   lost_frames_ = 0;
   ++stats_.tracking;
+  if (extrinsic_check_) {
+    // No solve runs now (flush() came first): the back-end's estimate may be replaced.
+    SE3 T_b_c;
+    const int cam = extrinsic_check_->check(map_, search_, frame, matches_, T_w_b, T_b_c);
+    if (cam >= 0) {
+      useExtrinsic(cam, T_b_c);
+      mapper_->setExtrinsic(cam, T_b_c);
+      reestimated_[cam] = 1;
+      ++stats_.extrinsic_reestimations;
+    }
+  }
   velocity_ = T_w_last_.inverse() * T_w_b;
   have_velocity_ = true;
   T_w_last_ = T_w_b;
@@ -142,7 +165,11 @@ void Odometry::flush() {
   const int slot = pending_keyframe_;
   pending_keyframe_ = -1;
   const auto start = Clock::now();
-  mapper_->finishOptimize();  // waits for the solve when it runs on the back-end thread
+  const bool applied = mapper_->finishOptimize();  // waits for the solve when it runs on the back-end thread
+  if (applied && options_.refine_extrinsics) {
+    // Tracking continues with the extrinsics the back-end refined, as it does with its poses and points.
+    for (int c = 0; c < rig_.size(); ++c) useExtrinsic(c, mapper_->extrinsic(c));
+  }
   timing_.backend_ms += msSince(start);
   finishKeyframe(slot);  // its culling counts as mapping
 }

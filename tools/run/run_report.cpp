@@ -119,6 +119,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("initializations").value(s.initializations);
   j.key("keyframes").value(s.keyframes);
   j.key("recoveries").value(s.recoveries);
+  j.key("extrinsic_reestimations").value(s.extrinsic_reestimations);
   j.key("rejected_images").value(pipeline.frontEnd().rejectedImages());
   j.key("timing_ms").beginObject();
   const std::pair<const char*, Summary> stages[] = {{"feature_extraction", summarize(features)},

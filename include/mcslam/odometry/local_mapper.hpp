@@ -48,6 +48,12 @@ class LocalMapper {
 
   void reset();
   Rig refinedRig() const;
+  // The back-end's current estimate of camera `cam`'s extrinsic (the rig's when there is no back-end). Not while
+  // a solve runs.
+  const SE3& extrinsic(int cam) const;
+  // Replaces that estimate; the camera's calibration prior is dropped (SlidingWindowSolver::setExtrinsic). False
+  // when the extrinsic is not refined or a solve runs.
+  bool setExtrinsic(int cam, const SE3& T_b_c);
   // Heap allocations made by the back-end thread, all solves (0 without it): for the fixed-memory tests.
   uint64_t backendThreadAllocations() const;
   uint64_t backendSolves() const { return backend_solves_; }
@@ -60,7 +66,9 @@ class LocalMapper {
   void backendRemoveLandmark(int lm);
   int keyframeSlotOfId(int64_t id) const;
 
-  const Rig& rig_;
+  const Rig& rig_;       // the odometry's: its extrinsics follow the estimates
+  Rig calibration_;      // the back-end's prior, also for a new window after a reset
+  std::vector<uint8_t> calibration_dropped_;  // per camera: setExtrinsic() showed its calibration wrong
   OdometryOptions options_;
   Map& map_;
   std::unique_ptr<backend::SlidingWindowSolver> solver_;

@@ -27,6 +27,7 @@ struct OdometryStats {
   uint64_t keyframes = 0;
   uint64_t recoveries = 0;          // frames tracked only through the descriptor fallback
   uint64_t backend_solves = 0;
+  uint64_t extrinsic_reestimations = 0;  // cameras whose extrinsic the per-camera check replaced
   double last_backend_ms = 0;
 };
 
@@ -37,6 +38,7 @@ struct OdometryTiming {
   double backend_ms = 0;    // sliding-window optimization
 };
 
+class ExtrinsicCheck;
 class Initializer;
 class LocalMapper;
 
@@ -58,6 +60,10 @@ class Odometry {
   const Map& map() const { return map_; }
   // The rig with the extrinsics the back-end refined (the calibration when refinement is off).
   Rig refinedRig() const;
+  // The rig tracking uses: with refinement on, the extrinsics as of the last applied solve or per-camera check.
+  const Rig& trackingRig() const { return rig_; }
+  // Whether the per-camera check found camera `cam`'s calibration wrong and re-estimated it.
+  bool extrinsicReestimated(int cam) const { return reestimated_[cam] != 0; }
   bool initialized() const { return initialized_; }
   // Heap allocations made on the back-end thread so far (0 when the solve runs inline).
   uint64_t backendThreadAllocations() const;
@@ -78,8 +84,9 @@ class Odometry {
   void resetMap();
   void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
   int searchNewestKeyframeByDescriptor(const FrameFeatures& frame);
+  void useExtrinsic(int cam, const SE3& T_b_c);  // in everything that tracks and maps
 
-  Rig rig_;
+  Rig rig_;  // with refinement on, its extrinsics follow the estimates (the back-end keeps the calibration as prior)
   OdometryOptions options_;
   int capacity_;
   Map map_;
@@ -89,6 +96,8 @@ class Odometry {
   PoseRefiner refiner_;
   std::unique_ptr<Initializer> initializer_;
   std::unique_ptr<LocalMapper> mapper_;
+  std::unique_ptr<ExtrinsicCheck> extrinsic_check_;  // with refinement on and several cameras
+  std::vector<uint8_t> reestimated_;                 // per camera
 
   std::vector<PoseObservation> observations_;  // built from matches_
   std::vector<KeypointRef> observation_refs_;  // which keypoint each observation is
