@@ -32,9 +32,22 @@ SlamPipeline::SlamPipeline(const Rig& rig, const PipelineConfig& config)
       features_(rig_.size(), config_.orb.max_features) {
   // Two: one being prepared while the other is finished.
   for (int k = 0; k < 2; ++k) stages_.push_back(Stage{FrameFeatures(rig_.size(), config_.orb.max_features), 0, 0, {}});
+  handover_ = effectiveOdometryOptions(config_, front_end_.overlap()).refine_extrinsics && rig_.size() > 1;
+  if (handover_) {
+    for (std::vector<SE3>& e : extrinsics_after_) {
+      for (const RigCamera& c : rig_.cameras) e.push_back(c.T_b_c);
+    }
+  }
 }
 
 void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing) {
+  if (handover_) {
+    if (features_computed_ >= 2) {  // the first two frames keep the calibration
+      const std::vector<SE3>& e = extrinsics_after_[features_computed_ % 2];
+      for (int c = 0; c < rig_.size(); ++c) front_end_.setBodyFromCamera(c, e[c]);
+    }
+    ++features_computed_;
+  }
   front_end_.compute(frame, out);
   const FrontEndTiming& f = front_end_.timing();
   timing.features_ms = f.extraction_ms + f.multiview_ms;
@@ -43,6 +56,13 @@ void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out
 void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out,
                          PipelineTiming& timing) {
   odometry_.process(features, sequence, out);
+  if (handover_) {
+    std::vector<SE3>& e = extrinsics_after_[frames_tracked_ % 2];
+    for (int c = 0; c < rig_.size(); ++c) {
+      e[c] = odometry_.extrinsicReestimated(c) ? odometry_.trackingRig().T_b_c(c) : rig_.T_b_c(c);
+    }
+    ++frames_tracked_;
+  }
   out.t = t;
   const OdometryTiming& o = odometry_.timing();
   timing.tracking_ms = o.tracking_ms + o.mapping_ms;
