@@ -79,7 +79,6 @@ class MultiViewMatcher {
   std::pair<int, int> pairCameras(int pair) const { return overlap_.overlappingPairs()[static_cast<size_t>(pair)]; }
   void matchPair(const FrameFeatures& frame, int pair, int thread);
   void finishFrame(FrameFeatures& frame);
-  int threads() const { return static_cast<int>(scratch_.size()); }
 
  private:
   struct Match {
