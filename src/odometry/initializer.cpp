@@ -96,6 +96,13 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
     last_status_ = RelativePoseStatus::TooFewCorrespondences;
     return TwoFrame::Waiting;
   }
+  if (rig_.size() > 1 && f.mv_count == 0 && reference_.mv_count == 0) {
+    last_metric_ = false;
+    const RelativePoseResult r = upToScale(frame_index, T_ref_cur);
+    last_status_ = r.status;
+    return r.ok() ? TwoFrame::Ready : TwoFrame::Waiting;
+  }
+  last_metric_ = rig_.size() > 1;
   const RelativePoseOptions ro = relativePoseOptions(frame_index);
   RelativePoseResult r;
   if (rig_.size() == 1) {
@@ -113,6 +120,37 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
     T_ref_cur = r.T_1_2;
   }
   return TwoFrame::Ready;
+}
+
+RelativePoseResult Initializer::upToScale(uint64_t frame_index, SE3& T_ref_cur) {
+  const RelativePoseOptions ro = relativePoseOptions(frame_index);
+  RelativePoseResult best;
+  int best_cam = -1;
+  for (int c = 0; c < rig_.size(); ++c) {
+    camera_matches_.clear();
+    for (const RelativeCorrespondence& m : correspondences_) {
+      if (m.camera1 == c) camera_matches_.push_back(m);
+    }
+    if (static_cast<int>(camera_matches_.size()) < ro.min_inliers) continue;
+    RelativePoseResult r = estimateCentralRelativePose(camera_matches_, ro);
+    // A camera with a sound pose beats one without; then the most inliers.
+    const bool better = best_cam < 0 || (r.ok() && !best.ok()) || (r.ok() == best.ok() && r.num_inliers > best.num_inliers);
+    if (better) {
+      best = std::move(r);
+      best_cam = c;
+    }
+  }
+  if (best_cam < 0) {
+    best.status = RelativePoseStatus::TooFewCorrespondences;
+    return best;
+  }
+  if (best.ok()) {
+    // The camera's unit translation becomes the body's motion: the map's unit is arbitrary until the window's
+    // turns fix it.
+    const SE3& T_b_c = rig_.T_b_c(best_cam);
+    T_ref_cur = T_b_c * best.T_1_2 * T_b_c.inverse();
+  }
+  return best;
 }
 
 }  // namespace mcslam

@@ -12,14 +12,17 @@ OdometryOptions effectiveOdometryOptions(const PipelineConfig& config, const Ove
     o.refine_extrinsics = false;
   } else {
     // A camera that overlaps no other could not be calibrated against a shared target: its extrinsic
-    // was chained (through an IMU) and deserves refinement.
-    bool isolated = false;
+    // was chained (through an IMU) and deserves refinement. Not when no two cameras overlap: the map's
+    // metric scale then comes from the calibrated lever arms alone, and refining them with it lets both
+    // shrink together (measured: the map collapsed and tracking was lost, BENCHMARKS.md section 1).
+    bool isolated = false, any_pair = false;
     for (int i = 0; i < overlap.cameras() && overlap.cameras() > 1; ++i) {
       bool any = false;
       for (int j = 0; j < overlap.cameras(); ++j) any = any || overlap.overlaps(i, j) || overlap.overlaps(j, i);
       isolated = isolated || !any;
+      any_pair = any_pair || any;
     }
-    o.refine_extrinsics = isolated;
+    o.refine_extrinsics = isolated && any_pair;
   }
   return o;
 }

@@ -2,7 +2,10 @@
 // Map initialization (paper section IV-B). From one rig frame when it has enough metric multi-view
 // features; otherwise from two frames, with the generalized relative pose (17-point in RANSAC) for
 // rigs of several cameras and the 5-point algorithm for one camera, after a parallax and
-// observability check. The two-frame path runs rarely and may allocate.
+// observability check. Two frames of a rig without overlap (no multi-view feature in either) cannot
+// observe the metric scale with lever arms of centimetres: such a rig starts up to scale, from the
+// 5-point pose of its best camera, and the odometry estimates the scale later over the back-end's
+// window (ScaleEstimator). The two-frame path runs rarely and may allocate.
 #include <vector>
 
 #include "mcslam/features/frame_features.hpp"
@@ -23,8 +26,10 @@ class Initializer {
 
   enum class TwoFrame { Waiting, Ready };
   // Feeds a frame to the two-frame initialization. Ready: T_ref_cur (current body frame -> reference body
-  // frame; metric for a rig, unit translation for one camera) is set and reference() is the first frame.
+  // frame) is set and reference() is the first frame. Its translation is metric when lastMetric(), else of
+  // arbitrary scale (unit translation of one camera).
   TwoFrame feed(const FrameFeatures& f, uint64_t frame_index, SE3& T_ref_cur);
+  bool lastMetric() const { return last_metric_; }
   const FrameFeatures& reference() const { return reference_; }
   uint64_t referenceIndex() const { return reference_index_; }
   bool hasReference() const { return has_reference_; }
@@ -48,6 +53,11 @@ class Initializer {
   bool has_reference_ = false;
   std::vector<RelativeCorrespondence> correspondences_;
   std::vector<int32_t> best_of_ref_;
+  // Up to scale from the one camera whose 5-point pose has the most inliers (rig without overlap).
+  RelativePoseResult upToScale(uint64_t frame_index, SE3& T_ref_cur);
+
+  std::vector<RelativeCorrespondence> camera_matches_;  // one camera's share of correspondences_
+  bool last_metric_ = true;
   RelativePoseStatus last_status_ = RelativePoseStatus::TooFewCorrespondences;
   int last_matches_ = 0;
 };
