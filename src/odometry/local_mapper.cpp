@@ -81,6 +81,24 @@ void LocalMapper::reset() {
   touched_count_ = 0;
 }
 
+void LocalMapper::rescale(double s, const Vec3& center) {
+  for (int i = 0; i < map_.keyframeCapacity(); ++i) {
+    Keyframe& k = map_.keyframe(i);
+    if (!k.alive) continue;
+    k.T_w_b.t = center + s * (k.T_w_b.t - center);
+    if (solver_ && k.in_backend) solver_->setKeyframePose(k.id, k.T_w_b);
+  }
+  for (int lm = 0; lm < map_.landmarkCapacity(); ++lm) {
+    Landmark& l = map_.landmark(lm);
+    if (!l.alive) continue;
+    l.p_w = center + s * (l.p_w - center);
+    if (solver_ && l.in_backend) solver_->setLandmarkPosition(lm, l.p_w);
+    // ORB finds it again over distances that scale with it.
+    l.min_distance *= static_cast<float>(s);
+    l.max_distance *= static_cast<float>(s);
+  }
+}
+
 Rig LocalMapper::refinedRig() const {
   if (worker_) worker_->wait();
   return solver_ ? solver_->refinedRig() : rig_;

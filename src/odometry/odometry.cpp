@@ -9,6 +9,7 @@
 #include "extrinsic_check.hpp"
 #include "mcslam/odometry/initializer.hpp"
 #include "mcslam/odometry/local_mapper.hpp"
+#include "mcslam/odometry/scale_estimator.hpp"
 
 namespace mcslam {
 
@@ -51,6 +52,12 @@ Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_featu
     extrinsic_check_ = std::make_unique<ExtrinsicCheck>(rig_, options_, max_features_per_camera);
   }
   reestimated_.assign(cams, 0);
+  if (cams > 1) {
+    const int window_obs = (options.window_keyframes + 1) * cams * max_features_per_camera;
+    scale_estimator_ = std::make_unique<ScaleEstimator>(rig_, std::min(options.max_landmarks, window_obs), window_obs,
+                                                        options.scale_factor, options.levels);
+    scale_filter_ = std::make_unique<ScaleFilter>();
+  }
   observations_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);
   observation_refs_.resize(observations_.size());
   last_tracked_.resize(options.max_landmarks);
@@ -85,6 +92,7 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
   out = PoseEstimate{};
   out.t = frame.t;
   out.sequence = frame_index;
+  frame_index_ = frame_index;
   flush();  // the previous keyframe's solve, before this frame reads the map
   const auto start = Clock::now();
   const double flushed_ms = timing_.mapping_ms + timing_.backend_ms;
@@ -187,7 +195,47 @@ void Odometry::finishKeyframe(int slot) {
     if (map_.landmark(last_tracked_[i]).alive) last_tracked_[kept++] = last_tracked_[i];
   }
   last_tracked_count_ = kept;
+  estimateScale();
   timing_.mapping_ms += msSince(cull_start);
+}
+
+void Odometry::estimateScale() {
+  if (!scale_free_start_ || !scale_estimator_) return;
+  // Before convergence at every keyframe, from a coarse search (the unit may be far off); afterwards once per
+  // window, from the map as it is: the check costs less.
+  ++keyframes_since_scale_;
+  if (scale_converged_ && keyframes_since_scale_ < options_.window_keyframes) return;
+  const int new_keyframes = keyframes_since_scale_;
+  keyframes_since_scale_ = 0;
+  const ScaleEstimate e = scale_estimator_->estimate(map_, scale_converged_ ? 1.0 : options_.scale_search_ratio);
+  ++stats_.scale_estimates;
+  if (!e.ok) return;
+  stats_.last_scale = e.scale;
+  stats_.last_scale_sigma = e.relative_sigma;
+  if (!scale_filter_->add(std::log(e.scale), e.relative_sigma, e.keyframes, new_keyframes)) return;  // an outlier
+  const double x = scale_filter_->correction(), sigma = scale_filter_->sigma();
+  stats_.combined_scale_sigma = sigma;
+  if (std::getenv("MCSLAM_DEBUG_SCALE")) {  // one line per estimate, for studies against ground truth
+    std::fprintf(stderr, "scale frame %llu: window %.4f sigma %.4f (%d keyframes, %d landmarks), combined %.4f sigma %.4f\n",
+                 static_cast<unsigned long long>(frame_index_), e.scale, e.relative_sigma, e.keyframes, e.landmarks,
+                 std::exp(x), sigma);
+  }
+  // Until the combined sigma reaches the bound nothing is applied (the back-end's own window pulls the scale
+  // meanwhile); afterwards a correction 3 sigma away from 1 is.
+  const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma;
+  if (!converges && !(scale_converged_ && std::abs(x) > 3.0 * sigma)) return;
+  // The whole live map, the window and the motion model take the new unit at once.
+  const double s = std::exp(x);
+  mapper_->rescale(s, e.center);
+  T_w_last_.t = e.center + s * (T_w_last_.t - e.center);
+  last_keyframe_pose_.t = e.center + s * (last_keyframe_pose_.t - e.center);
+  velocity_.t *= s;
+  scale_filter_->applied();
+  ++stats_.scale_rescales;
+  if (converges) {
+    scale_converged_ = true;
+    stats_.scale_converged_frame = static_cast<int64_t>(frame_index_);
+  }
 }
 
 void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
@@ -195,6 +243,7 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   out.state = TrackingState::NotInitialized;
   int kf_new = -1;
   last_init_reference_ = -1;
+  bool metric = true;
   if (initializer_->oneFrameReady(frame)) {
     // Enough metric multi-view features: the map starts from this frame alone.
     resetMap();
@@ -223,6 +272,7 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
         mapper_->optimize(kf_new);
         timing_.backend_ms = msSince(be_start);
         last_init_reference_ = static_cast<int64_t>(ref_index);
+        metric = initializer_->lastMetric() || rig_.size() == 1;  // one camera: never metric, nothing to wait for
       }
     }
   }
@@ -232,6 +282,10 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   }
   initializer_->reset();
   initialized_ = true;
+  scale_converged_ = metric;
+  scale_free_start_ = !metric;
+  keyframes_since_scale_ = 0;
+  if (scale_filter_) scale_filter_->reset();
   ++stats_.initializations;
   ++stats_.keyframes;
   T_w_last_ = map_.keyframe(kf_new).T_w_b;

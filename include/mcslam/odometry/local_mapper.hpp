@@ -47,6 +47,9 @@ class LocalMapper {
   int cull(int newest_slot);
 
   void reset();
+  // Multiplies every keyframe position and landmark, in the map and in the back-end's window, about `center`
+  // (a new metric scale). No solve may be in flight.
+  void rescale(double s, const Vec3& center);
   Rig refinedRig() const;
   // The back-end's current estimate of camera `cam`'s extrinsic (the rig's when there is no back-end). Not while
   // a solve runs.

@@ -3,6 +3,7 @@
 // of every frame against the local map, keyframes, new landmarks from multi-view features and from
 // rays of different cameras and times, and the sliding-window back-end. Works for one camera, for
 // overlapping and for non-overlapping rigs alike. All memory is allocated at construction.
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -29,6 +30,14 @@ struct OdometryStats {
   uint64_t backend_solves = 0;
   uint64_t extrinsic_reestimations = 0;  // cameras whose extrinsic the per-camera check replaced
   double last_backend_ms = 0;
+  // Metric scale of a rig without overlap (started up to scale): frame from which the map is metric (-1: not
+  // yet, or the map started metric), the window's scale estimates and the rescalings they caused.
+  int64_t scale_converged_frame = -1;
+  uint64_t scale_estimates = 0;
+  uint64_t scale_rescales = 0;
+  double last_scale = 1;              // factor of the last window estimate
+  double last_scale_sigma = INFINITY; // its sigma(s) / s
+  double combined_scale_sigma = INFINITY;  // of the estimates combined (ScaleFilter)
 };
 
 // Milliseconds spent in the stages of the last processed frame.
@@ -41,6 +50,8 @@ struct OdometryTiming {
 class ExtrinsicCheck;
 class Initializer;
 class LocalMapper;
+class ScaleEstimator;
+class ScaleFilter;
 
 class Odometry {
  public:
@@ -65,6 +76,9 @@ class Odometry {
   // Whether the per-camera check found camera `cam`'s calibration wrong and re-estimated it.
   bool extrinsicReestimated(int cam) const { return reestimated_[cam] != 0; }
   bool initialized() const { return initialized_; }
+  // False while a map started up to scale (rig without overlap) waits for its window to fix the scale: poses
+  // until then have an arbitrary unit. True for a metric start and for one camera (whose scale never is).
+  bool scaleConverged() const { return scale_converged_; }
   // Heap allocations made on the back-end thread so far (0 when the solve runs inline).
   uint64_t backendThreadAllocations() const;
   // Frame index of the reference frame of the last initialization when it used two frames (the frames
@@ -83,6 +97,10 @@ class Odometry {
   void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
   void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
+  // Estimates the scale of a map started up to scale over the back-end's window at every keyframe, and
+  // rescales the map when the combined estimate is certain (the first time: the scale has converged) or
+  // significantly off.
+  void estimateScale();
   int searchNewestKeyframeByDescriptor(const FrameFeatures& frame);
   void useExtrinsic(int cam, const SE3& T_b_c);  // in everything that tracks and maps
 
@@ -98,6 +116,8 @@ class Odometry {
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<ExtrinsicCheck> extrinsic_check_;  // with refinement on and several cameras
   std::vector<uint8_t> reestimated_;                 // per camera
+  std::unique_ptr<ScaleEstimator> scale_estimator_;  // null for one camera
+  std::unique_ptr<ScaleFilter> scale_filter_;
 
   std::vector<PoseObservation> observations_;  // built from matches_
   std::vector<KeypointRef> observation_refs_;  // which keypoint each observation is
@@ -117,6 +137,10 @@ class Odometry {
   int pending_keyframe_ = -1;     // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
   int64_t last_init_reference_ = -1;
+  bool scale_converged_ = true;
+  bool scale_free_start_ = false;  // the map started up to scale: its scale is estimated at keyframes
+  int keyframes_since_scale_ = 0;
+  uint64_t frame_index_ = 0;      // of the frame being processed
   OdometryStats stats_;
   OdometryTiming timing_;
 };

@@ -1,0 +1,105 @@
+#pragma once
+// Metric scale of a map that a rig of non-overlapping cameras started up to scale. Two frames cannot fix it
+// with lever arms of centimetres (BENCHMARKS.md, "Why the non-overlapping rig fails"); a window of keyframes
+// that turns can: the cameras' centres then move differently from the body, and only one scale explains the
+// reprojections through the metric extrinsics.
+//
+// Over the back-end's window (extrinsics held at the calibration, the oldest keyframe fixed):
+//  1. coarse: keyframe positions relative to the oldest keyframe and the landmarks multiplied by one factor,
+//     every landmark re-triangulated for it (rotations held); a scan over log s brings a map whose unit is
+//     far off into the basin;
+//  2. fine: Gauss-Newton on the whole window (poses and landmarks, landmarks eliminated by the Schur
+//     complement) from there. The scale is u = log of the summed keyframe distances from the oldest one; its
+//     sigma is the MARGINAL one (g^T S^-1 g over the reduced pose system), inflated by the reduced chi-square:
+//     holding the poses would give a sigma many times too small, as the poses absorb much of a scale error.
+// The caller applies exp(u) - the window's scale, nothing else (the back-end refines the rest).
+// Fixed memory: buffers sized at construction (the reduced system is at most kMaxKeyframes poses).
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mcslam/backend/robust_loss.hpp"
+#include "mcslam/odometry/map.hpp"
+
+namespace mcslam {
+
+struct ScaleEstimate {
+  bool ok = false;                   // a minimum inside the searched range, with a finite curvature
+  double scale = 1;                  // multiply positions about `center` by this
+  double relative_sigma = INFINITY;  // sigma(s) / s
+  Vec3 center = Vec3::Zero();        // position of the window's oldest keyframe
+  int keyframes = 0;
+  int landmarks = 0;
+  int observations = 0;
+};
+
+class ScaleEstimator {
+ public:
+  // max_observations: observations of window landmarks by window keyframes (window * cameras * features).
+  ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, float octave_scale_factor, int levels);
+
+  // Uses the keyframes with in_backend set and the landmarks two of them observe. `max_ratio` bounds the
+  // coarse search: s in [1 / max_ratio, max_ratio]; at most 1, Gauss-Newton starts from the map as it is.
+  ScaleEstimate estimate(const Map& map, double max_ratio);
+  static constexpr int kMaxKeyframes = 16;
+
+ private:
+  static constexpr int kMaxDim = 6 * (kMaxKeyframes - 1);
+  using Reduced = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDim, kMaxDim>;
+  using ReducedVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDim, 1>;
+  struct Obs {
+    int16_t kf;   // index into kf_R_/kf_t_
+    int16_t cam;
+    Vec2 uv;
+    double inv_sigma;
+  };
+  double cost(double s, int* residuals = nullptr);
+  // Robust cost of landmark l at p (refined first when asked), keyframes at kf_T_ with positions times s.
+  double landmarkCost(int l, double s, Vec3& p, bool refine, int* residuals);
+  // One Gauss-Newton step of the window from kf_T_ / lm_p_ (landmarks re-triangulated first), and the
+  // variance of u it implies. False when singular.
+  bool reducedSystem(ReducedVec& step, double& chi2, int& residuals);
+  double scaleOfPoses() const;  // summed distances of the keyframes from the oldest (the centre)
+
+  const Rig& rig_;
+  backend::RobustLoss loss_;
+  std::vector<double> octave_sigma_;
+  std::vector<SE3> kf_T_;      // per window keyframe: T_w_b, translation relative to the centre
+  int oldest_ = 0;              // window index of the oldest keyframe (held)
+  Reduced S_;
+  ReducedVec b_, g_;
+  double scale_variance_ = 0;  // g^T S^-1 g of the last reduced system
+  std::vector<int> kf_slot_of_;  // map keyframe slot -> window index (-1)
+  std::vector<Vec3> lm_p_;      // per landmark: position relative to the centre
+  std::vector<int> lm_first_;   // per landmark: first observation (lm_first_[l + 1] ends it)
+  std::vector<Obs> obs_;
+  int nk_ = 0, nl_ = 0, no_ = 0;
+};
+
+// The window estimates, combined into the map's log-scale error. Windows that share keyframes are not
+// independent: an estimate counts as much as the keyframes new to it (its variance times window keyframes
+// over new keyframes). An estimate that disagrees with the combined one by more than 3 sigma is
+// dropped; when the windows of several keyframes in a row disagree, the map's scale has drifted (a straight
+// stretch hides it) and the combination restarts from the latest.
+class ScaleFilter {
+ public:
+  void reset() {
+    x_ = 0;
+    info_ = 0;
+    rejected_ = 0;
+  }
+  // False when the estimate was dropped as an outlier.
+  bool add(double log_scale, double sigma, int window_keyframes, int new_keyframes);
+  double correction() const { return x_; }  // log of the factor the map needs
+  double sigma() const { return info_ > 0 ? 1.0 / std::sqrt(info_) : INFINITY; }
+  void applied() { x_ = 0; }  // the map took the correction: what is known of its scale stays
+
+ private:
+  static constexpr int kRestartAfter = 3;
+  double x_ = 0, info_ = 0;
+  int rejected_ = 0;
+  bool restarted_ = false;
+};
+
+}  // namespace mcslam

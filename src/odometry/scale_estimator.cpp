@@ -1,0 +1,290 @@
+#include "mcslam/odometry/scale_estimator.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <limits>
+
+#include "mcslam/backend/reprojection_residual.hpp"
+
+namespace mcslam {
+
+namespace {
+// A ray that no longer projects costs as much as a residual of this many sigmas: large, but bounded, so
+// that the cost stays continuous enough to search.
+constexpr double kMissingSigmas = 10.0;
+constexpr int kGaussNewtonSteps = 4;
+}  // namespace
+
+ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, float octave_scale_factor,
+                               int levels)
+    : rig_(rig) {
+  for (int o = 0; o < std::max(levels, 1); ++o) octave_sigma_.push_back(std::pow(octave_scale_factor, o));
+  kf_T_.resize(kMaxKeyframes);
+  lm_p_.resize(max_landmarks);
+  lm_first_.resize(static_cast<std::size_t>(max_landmarks) + 1);
+  obs_.resize(max_observations);
+}
+
+double ScaleEstimator::landmarkCost(int l, double s, Vec3& p, bool refine, int* residuals) {
+  const int begin = lm_first_[l], end = lm_first_[l + 1];
+  const double missing = loss_.rho(kMissingSigmas * kMissingSigmas);
+  auto cameraPoint = [&](const Obs& o) {
+    const SE3& T_b_c = rig_.T_b_c(o.cam);
+    const SE3& T = kf_T_[o.kf];
+    return Vec3(T_b_c.R.transpose() * (T.R.transpose() * (p - s * T.t) - T_b_c.t));
+  };
+  for (int it = 0; it < (refine ? 2 : 0); ++it) {
+    Mat3 H = Mat3::Zero();
+    Vec3 g = Vec3::Zero();
+    for (int i = begin; i < end; ++i) {
+      const Obs& o = obs_[i];
+      Vec2 uv;
+      Mat23 J;
+      if (!rig_.model(o.cam).project(cameraPoint(o), uv, &J)) continue;
+      const Vec2 r = (uv - o.uv) * o.inv_sigma;
+      double rho, w;
+      loss_.evaluate(r.squaredNorm(), rho, w);
+      const Mat23 Jp = o.inv_sigma * J * rig_.T_b_c(o.cam).R.transpose() * kf_T_[o.kf].R.transpose();
+      H.noalias() += w * Jp.transpose() * Jp;
+      g.noalias() += w * Jp.transpose() * r;
+    }
+    H.diagonal().array() += 1e-9 + 1e-6 * H.diagonal().array();  // a ray pair without parallax stays put
+    const Vec3 dp = H.ldlt().solve(-g);
+    if (!dp.allFinite()) break;
+    p += dp;
+  }
+  double c = 0;
+  for (int i = begin; i < end; ++i) {
+    const Obs& o = obs_[i];
+    Vec2 uv;
+    if (!rig_.model(o.cam).project(cameraPoint(o), uv)) {
+      c += missing;
+      continue;
+    }
+    c += loss_.rho(((uv - o.uv) * o.inv_sigma).squaredNorm());
+    if (residuals) ++*residuals;
+  }
+  return 0.5 * c;
+}
+
+double ScaleEstimator::cost(double s, int* residuals) {
+  double c = 0;
+  for (int l = 0; l < nl_; ++l) {
+    Vec3 p = s * lm_p_[l];
+    c += landmarkCost(l, s, p, true, residuals);
+  }
+  return c;
+}
+
+double ScaleEstimator::scaleOfPoses() const {
+  double sum = 0;
+  for (int w = 0; w < nk_; ++w) sum += (kf_T_[w].t - kf_T_[oldest_].t).norm();
+  return sum;
+}
+
+bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residuals) {
+  const int dim = 6 * (nk_ - 1);
+  auto freeIndex = [&](int w) { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); };
+  S_.setZero(dim, dim);
+  b_.setZero(dim);
+  chi2 = 0;
+  residuals = 0;
+  Eigen::Matrix<double, 6, 3> W[kMaxLandmarkObservations];
+  int wf[kMaxLandmarkObservations];
+  SE3 T_b_w[kMaxKeyframes];
+  for (int w = 0; w < nk_; ++w) T_b_w[w] = kf_T_[w].inverse();
+  for (int l = 0; l < nl_; ++l) {
+    Vec3 p = lm_p_[l];
+    landmarkCost(l, 1.0, p, true, nullptr);  // the landmark's best position for these poses
+    lm_p_[l] = p;
+    Mat3 Hll = Mat3::Zero();
+    Vec3 bl = Vec3::Zero();
+    int m = 0;
+    for (int i = lm_first_[l]; i < lm_first_[l + 1]; ++i) {
+      const Obs& o = obs_[i];
+      Vec2 r;
+      backend::ReprojectionJacobians J;
+      if (!backend::reprojectionResidualInverse(rig_.model(o.cam), T_b_w[o.kf], rig_.T_b_c(o.cam).inverse(), p, o.uv,
+                                                o.inv_sigma, r, &J)) {
+        continue;
+      }
+      double rho, wt;
+      loss_.evaluate(r.squaredNorm(), rho, wt);
+      chi2 += rho;
+      ++residuals;
+      Hll.noalias() += wt * J.point.transpose() * J.point;
+      bl.noalias() += wt * J.point.transpose() * r;
+      const int f = freeIndex(o.kf);
+      if (f < 0 || m >= kMaxLandmarkObservations) continue;
+      S_.block<6, 6>(6 * f, 6 * f).noalias() += wt * J.pose.transpose() * J.pose;
+      b_.segment<6>(6 * f).noalias() += wt * J.pose.transpose() * r;
+      W[m] = wt * J.pose.transpose() * J.point;
+      wf[m++] = f;
+    }
+    Hll.diagonal().array() += 1e-9;
+    const Mat3 Hinv = Hll.inverse();
+    if (!Hinv.allFinite()) continue;
+    for (int a = 0; a < m; ++a) {
+      const Eigen::Matrix<double, 6, 3> WH = W[a] * Hinv;
+      b_.segment<6>(6 * wf[a]).noalias() -= WH * bl;
+      for (int c = 0; c < m; ++c) S_.block<6, 6>(6 * wf[a], 6 * wf[c]).noalias() -= WH * W[c].transpose();
+    }
+  }
+  // Scale gradient: u = log(sum of |t_i - t_oldest|), right perturbation moves t_i by R_i rho.
+  const double sum = scaleOfPoses();
+  g_.setZero(dim);
+  if (!(sum > 0)) return false;
+  for (int w = 0; w < nk_; ++w) {
+    const int f = freeIndex(w);
+    const Vec3 d = kf_T_[w].t - kf_T_[oldest_].t;
+    if (f >= 0 && d.norm() > 0) g_.segment<3>(6 * f) = kf_T_[w].R.transpose() * d / (d.norm() * sum);
+  }
+  S_.diagonal().array() += 1e-9 + 1e-6 * S_.diagonal().array();
+  const Eigen::LDLT<Reduced> ldlt(S_);
+  if (ldlt.info() != Eigen::Success) return false;
+  step = ldlt.solve(-b_);
+  const ReducedVec Sg = ldlt.solve(g_);
+  scale_variance_ = g_.dot(Sg);  // of u, in units of the pixel sigmas
+  return step.allFinite() && std::isfinite(scale_variance_);
+}
+
+ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
+  ScaleEstimate out;
+  // The window's keyframes; the oldest is the centre (the back-end holds it fixed).
+  kf_slot_of_.assign(map.keyframeCapacity(), -1);  // sized once: the map's capacity does not change
+  nk_ = 0;
+  int oldest = -1;
+  for (int i = 0; i < map.keyframeCapacity(); ++i) {
+    const Keyframe& k = map.keyframe(i);
+    if (!k.alive || !k.in_backend) continue;
+    if (nk_ >= kMaxKeyframes) return out;
+    kf_slot_of_[i] = nk_++;
+    if (oldest < 0 || k.id < map.keyframe(oldest).id) oldest = i;
+  }
+  out.keyframes = nk_;
+  if (nk_ < 3) return out;
+  out.center = map.keyframe(oldest).T_w_b.t;
+  oldest_ = kf_slot_of_[oldest];
+  for (int i = 0; i < map.keyframeCapacity(); ++i) {
+    if (kf_slot_of_[i] < 0) continue;
+    kf_T_[kf_slot_of_[i]] = map.keyframe(i).T_w_b;
+    kf_T_[kf_slot_of_[i]].t -= out.center;
+  }
+  // Landmarks seen from two window keyframes, with their window observations.
+  nl_ = 0;
+  no_ = 0;
+  for (int lm = 0; lm < map.landmarkCapacity() && nl_ < static_cast<int>(lm_p_.size()); ++lm) {
+    const Landmark& L = map.landmark(lm);
+    if (!L.alive) continue;
+    int first_kf = -1, distinct = 0, n = 0;
+    for (int j = 0; j < L.obs_count; ++j) {
+      const int w = kf_slot_of_[L.obs[j].keyframe];
+      if (w < 0) continue;
+      ++n;
+      if (first_kf < 0) first_kf = w;
+      distinct = w != first_kf ? 2 : std::max(distinct, 1);
+    }
+    if (distinct < 2 || no_ + n > static_cast<int>(obs_.size())) continue;
+    lm_first_[nl_] = no_;
+    for (int j = 0; j < L.obs_count; ++j) {
+      const int w = kf_slot_of_[L.obs[j].keyframe];
+      if (w < 0) continue;
+      const Keypoint& kp = map.keyframe(L.obs[j].keyframe).features.sets[L.obs[j].cam].keypoints[L.obs[j].kp];
+      const int octave = std::clamp<int>(kp.octave, 0, static_cast<int>(octave_sigma_.size()) - 1);
+      obs_[no_++] = Obs{static_cast<int16_t>(w), L.obs[j].cam, Vec2(kp.x, kp.y), 1.0 / octave_sigma_[octave]};
+    }
+    lm_p_[nl_] = L.p_w - out.center;
+    ++nl_;
+  }
+  lm_first_[nl_] = no_;
+  out.landmarks = nl_;
+  out.observations = no_;
+  if (nl_ < 20) return out;
+  const double scale_before = scaleOfPoses();
+  if (!(scale_before > 0)) return out;
+
+  // 1. Coarse (max_ratio > 1): scan log s, then golden-section search around the best sample.
+  double s_coarse = 1.0;
+  if (max_ratio > 1.0) {
+    const double umax = std::log(max_ratio);
+    const int steps = std::max(2, static_cast<int>(std::ceil(umax / std::log(1.25))));
+    const double du = umax / steps;
+    int best = 0;
+    double best_cost = std::numeric_limits<double>::infinity();
+    for (int i = -steps; i <= steps; ++i) {
+      const double c = cost(std::exp(i * du));
+      if (c < best_cost) {
+        best_cost = c;
+        best = i;
+      }
+    }
+    if (best == -steps || best == steps) return out;  // no minimum inside the range: the window says nothing
+    constexpr double kGolden = 0.6180339887498949;
+    double a = (best - 1) * du, b = (best + 1) * du;
+    double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
+    double f1 = cost(std::exp(x1)), f2 = cost(std::exp(x2));
+    while (b - a > 1e-3) {
+      if (f1 < f2) {
+        b = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = b - kGolden * (b - a);
+        f1 = cost(std::exp(x1));
+      } else {
+        a = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = a + kGolden * (b - a);
+        f2 = cost(std::exp(x2));
+      }
+    }
+    s_coarse = std::exp(0.5 * (a + b));
+  }
+  for (int w = 0; w < nk_; ++w) kf_T_[w].t *= s_coarse;
+  for (int l = 0; l < nl_; ++l) lm_p_[l] *= s_coarse;
+
+  // 2. Fine: Gauss-Newton on the whole window; the last system gives the marginal sigma.
+  const auto freeIndex = [&](int w) { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); };
+  ReducedVec step;
+  double chi2 = 0, first_chi2 = 0, last_u_step = 0;
+  int residuals = 0;
+  for (int it = 0;; ++it) {
+    if (!reducedSystem(step, chi2, residuals)) return out;
+    if (it == 0) first_chi2 = chi2;
+    if (it == kGaussNewtonSteps) break;
+    last_u_step = g_.dot(step);  // first-order change of u by this step
+    for (int w = 0; w < nk_; ++w) {
+      const int f = freeIndex(w);
+      if (f >= 0) kf_T_[w] = kf_T_[w] * SE3::exp(step.segment<6>(6 * f));
+    }
+  }
+  // Gauss-Newton that raised the cost, or still moves the scale by more than its sigma, has not found the
+  // window's minimum: its curvature says nothing about the scale.
+  if (!(chi2 <= first_chi2) || !(last_u_step * last_u_step <= scale_variance_)) return out;
+  const double dof = std::max(1.0, 2.0 * residuals - 3.0 * nl_ - 6.0 * (nk_ - 1));
+  const double reduced = std::max(1.0, chi2 / dof);
+  const double variance = scale_variance_ * reduced;
+  if (!(variance > 0)) return out;
+  out.scale = scaleOfPoses() / scale_before;
+  out.relative_sigma = std::sqrt(variance);
+  out.ok = std::isfinite(out.scale) && out.scale > 0;
+  return out;
+}
+
+bool ScaleFilter::add(double log_scale, double sigma, int window_keyframes, int new_keyframes) {
+  const double r = sigma * sigma * std::max(1, window_keyframes) / std::clamp(new_keyframes, 1, std::max(1, window_keyframes));
+  restarted_ = false;
+  if (info_ > 0 && (log_scale - x_) * (log_scale - x_) > 9.0 * (r + 1.0 / info_)) {
+    // One window off by 3 sigma is an outlier; several in a row (they share keyframes) mean the map's scale moved.
+    if (++rejected_ < kRestartAfter) return false;
+    info_ = 0;
+    restarted_ = true;
+  }
+  rejected_ = 0;
+  x_ = (x_ * info_ + log_scale / r) / (info_ + 1.0 / r);
+  info_ += 1.0 / r;
+  return true;
+}
+
+}  // namespace mcslam
