@@ -135,7 +135,8 @@ int main(int argc, char** argv) {
       pipeline.track(buffers[i % 2], i, ds.frames()[i].t, pose, timing);
       timing.total_ms = prepared.wall_ms + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - track_start).count();
       // Losing and regaining track are worth a line of their own (the stats file lists them all).
-      if (report.add(pose, timing) && !quiet && i > 0) {
+      const bool unknown_scale = pipeline.odometry().initialized() && !pipeline.odometry().scaleConverged();
+      if (report.add(pose, timing, unknown_scale) && !quiet && i > 0) {
         std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s\n", show ? "\r\033[K" : "", i, toSeconds(pose.t),
                      trackingStateName(pose.state));
       }
@@ -144,6 +145,10 @@ int main(int argc, char** argv) {
         report.backfill(static_cast<uint64_t>(pipeline.odometry().lastInitializationReference()), i);
       }
       was_initialized = initialized;
+      if (!quiet && pipeline.stats().scale_converged_frame == static_cast<int64_t>(i) && pose.valid) {
+        std::fprintf(stderr, "%smcslam-run: frame %zu: metric scale found (sigma %.1f%%)\n", show ? "\r\033[K" : "", i,
+                     100.0 * pipeline.stats().combined_scale_sigma);
+      }
       if (pose.is_keyframe) report.noteKeyframes(pipeline.odometry().map());
       ms_avg = i == 0 ? timing.total_ms : 0.95 * ms_avg + 0.05 * timing.total_ms;
       if (show && (i % 5 == 0 || i + 1 == frames)) progress(i + 1, frames, ms_avg, pose);

@@ -1,6 +1,7 @@
 #include "run_report.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include "mcslam/core/error.hpp"
@@ -8,8 +9,9 @@
 
 namespace mcslam::run {
 
-bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
+bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing, bool unknown_scale) {
   FrameRecord r;
+  r.unknown_scale = unknown_scale && pose.valid;
   r.t = pose.t;
   r.pose = pose;
   r.timing = timing;
@@ -31,6 +33,7 @@ void RunReport::backfill(uint64_t reference_index, uint64_t init_index) {
     frames_[i].pose.T_w_b = a * SE3::exp(s * xi);
     frames_[i].pose.valid = true;
     frames_[i].interpolated = true;
+    frames_[i].unknown_scale = frames_[init_index].unknown_scale;
   }
 }
 
@@ -82,7 +85,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   if (!out) throw InputError(path + ": cannot write stats file");
   std::vector<double> features, tracking, optimization, total;
   uint64_t state_count[3] = {0, 0, 0};
-  int interpolated = 0;
+  int interpolated = 0, unknown_scale = 0;
   for (const FrameRecord& r : frames_) {
     features.push_back(r.timing.features_ms);
     tracking.push_back(r.timing.tracking_ms);
@@ -90,6 +93,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     total.push_back(r.timing.total_ms);
     ++state_count[static_cast<int>(r.pose.state)];
     interpolated += r.interpolated ? 1 : 0;
+    unknown_scale += r.unknown_scale ? 1 : 0;
   }
   const OdometryStats& s = pipeline.stats();
   JsonWriter j(out);
@@ -116,6 +120,17 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   }
   j.endArray();
   j.key("interpolated_before_initialization").value(interpolated);
+  // A rig without overlap starts up to scale: its poses have an arbitrary unit until the back-end's window
+  // fixes the scale (frame of convergence; -1: the map started metric, or never converged).
+  j.key("scale").beginObject();
+  j.key("converged_frame").value(static_cast<long long>(s.scale_converged_frame));
+  j.key("frames_unknown_scale").value(unknown_scale);
+  j.key("estimates").value(s.scale_estimates);
+  j.key("rescales").value(s.scale_rescales);
+  j.key("last_factor").value(s.last_scale);
+  j.key("last_relative_sigma").value(std::isfinite(s.last_scale_sigma) ? s.last_scale_sigma : -1.0);
+  j.key("combined_relative_sigma").value(std::isfinite(s.combined_scale_sigma) ? s.combined_scale_sigma : -1.0);
+  j.endObject();
   j.key("initializations").value(s.initializations);
   j.key("keyframes").value(s.keyframes);
   j.key("recoveries").value(s.recoveries);
