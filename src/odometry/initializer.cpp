@@ -134,7 +134,8 @@ RelativePoseResult Initializer::upToScale(uint64_t frame_index, SE3& T_ref_cur) 
     if (static_cast<int>(camera_matches_.size()) < ro.min_inliers) continue;
     RelativePoseResult r = estimateCentralRelativePose(camera_matches_, ro);
     // A camera with a sound pose beats one without; then the most inliers.
-    const bool better = best_cam < 0 || (r.ok() && !best.ok()) || (r.ok() == best.ok() && r.num_inliers > best.num_inliers);
+    const bool better =
+        best_cam < 0 || (r.ok() && !best.ok()) || (r.ok() == best.ok() && r.num_inliers > best.num_inliers);
     if (better) {
       best = std::move(r);
       best_cam = c;

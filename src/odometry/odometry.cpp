@@ -216,7 +216,8 @@ void Odometry::estimateScale() {
   const double x = scale_filter_->correction(), sigma = scale_filter_->sigma();
   stats_.combined_scale_sigma = sigma;
   if (std::getenv("MCSLAM_DEBUG_SCALE")) {  // one line per estimate, for studies against ground truth
-    std::fprintf(stderr, "scale frame %llu: window %.4f sigma %.4f (%d keyframes, %d landmarks), combined %.4f sigma %.4f\n",
+    std::fprintf(stderr, "scale frame %llu: window %.4f sigma %.4f (%d keyframes, %d landmarks), "
+                 "combined %.4f sigma %.4f\n",
                  static_cast<unsigned long long>(frame_index_), e.scale, e.relative_sigma, e.keyframes, e.landmarks,
                  std::exp(x), sigma);
   }

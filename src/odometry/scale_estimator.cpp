@@ -273,13 +273,12 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
 }
 
 bool ScaleFilter::add(double log_scale, double sigma, int window_keyframes, int new_keyframes) {
-  const double r = sigma * sigma * std::max(1, window_keyframes) / std::clamp(new_keyframes, 1, std::max(1, window_keyframes));
-  restarted_ = false;
+  const int window = std::max(1, window_keyframes);
+  const double r = sigma * sigma * window / std::clamp(new_keyframes, 1, window);
   if (info_ > 0 && (log_scale - x_) * (log_scale - x_) > 9.0 * (r + 1.0 / info_)) {
     // One window off by 3 sigma is an outlier; several in a row (they share keyframes) mean the map's scale moved.
     if (++rejected_ < kRestartAfter) return false;
     info_ = 0;
-    restarted_ = true;
   }
   rejected_ = 0;
   x_ = (x_ * info_ + log_scale / r) / (info_ + 1.0 / r);

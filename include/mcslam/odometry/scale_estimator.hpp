@@ -99,7 +99,6 @@ class ScaleFilter {
   static constexpr int kRestartAfter = 3;
   double x_ = 0, info_ = 0;
   int rejected_ = 0;
-  bool restarted_ = false;
 };
 
 }  // namespace mcslam
