@@ -90,7 +90,7 @@ SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
   SolveSummary summary;
   const int analyses_before = reduced.analyses();
   WindowLinearization& lin = linearization;
-  if (!lin.prepare(window)) {
+  if (!lin.prepare(window, options.gauge_fixed_oldest)) {
     summary.failed = true;
     classifyOutliers();
     summary.outliers = static_cast<int>(outliers.size());
@@ -226,6 +226,11 @@ Status SlidingWindowSolver::setKeyframeFixed(int64_t id, bool fixed) {
   const int s = impl_->window.keyframeSlot(id);
   if (s < 0) return Status::UnknownKeyframe;
   impl_->window.keyframes[s].fixed_by_caller = fixed;
+  return Status::Ok;
+}
+Status SlidingWindowSolver::setGaugeFixedOldest(int count) {
+  if (count < 0) return Status::InvalidValue;
+  impl_->options.gauge_fixed_oldest = count;
   return Status::Ok;
 }
 Status SlidingWindowSolver::setKeyframePose(int64_t id, const SE3& T_w_b) {

@@ -62,11 +62,11 @@ WindowLinearization::WindowLinearization(const WindowStorage& window, const Solv
   ext_d_trial_.resize(num_cameras_);
 }
 
-bool WindowLinearization::prepare(const WindowStorage& window) {
+bool WindowLinearization::prepare(const WindowStorage& window, int fixed_oldest) {
   // Gauge: the oldest keyframes (and those the caller fixed) are held fixed. -2 marks fixed.
   const int K = static_cast<int>(window.keyframes.size());
   std::fill(pose_block_.begin(), pose_block_.end(), -1);
-  for (int i = 0; i < options_.gauge_fixed_oldest; ++i) {
+  for (int i = 0; i < fixed_oldest; ++i) {
     int oldest = -1;
     for (int s = 0; s < K; ++s) {
       const KeyframeState& kf = window.keyframes[s];

@@ -15,9 +15,9 @@ class WindowLinearization {
  public:
   WindowLinearization(const WindowStorage& window, const SolverOptions& options);
 
-  // Chooses the free variables (gauge) and collects the landmarks with >= 2 observations.
-  // False when there is nothing to optimize.
-  bool prepare(const WindowStorage& window);
+  // Chooses the free variables (gauge: the `fixed_oldest` oldest keyframes and those the caller fixed are
+  // held) and collects the landmarks with >= 2 observations. False when there is nothing to optimize.
+  bool prepare(const WindowStorage& window, int fixed_oldest);
   // Residuals, robust weights and Jacobians at the current state. `select_landmarks` (first call
   // of a solve) drops observations that do not project and landmarks that are not constrained.
   void linearize(const WindowStorage& window, const MarginalizationPrior& prior, bool select_landmarks);

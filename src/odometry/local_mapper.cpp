@@ -99,6 +99,10 @@ void LocalMapper::rescale(double s, const Vec3& center) {
   }
 }
 
+void LocalMapper::holdScale(bool hold) {
+  if (solver_) solver_->setGaugeFixedOldest(hold || monocular_ ? 2 : 1);
+}
+
 Rig LocalMapper::refinedRig() const {
   if (worker_) worker_->wait();
   return solver_ ? solver_->refinedRig() : rig_;

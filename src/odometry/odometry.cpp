@@ -235,6 +235,10 @@ void Odometry::estimateScale() {
   ++stats_.scale_rescales;
   if (converges) {
     scale_converged_ = true;
+    // From now on the window holds this scale (its two oldest keyframes fixed) and only these estimates change
+    // it: left free, it random-walked wherever no turn constrained it (the 33 cm rig's map shrank to a tenth
+    // on a straight stretch). resetMap() lets it go with the window.
+    mapper_->holdScale(true);
     stats_.scale_converged_frame = static_cast<int64_t>(frame_index_);
   }
 }

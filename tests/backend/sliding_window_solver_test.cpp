@@ -184,6 +184,31 @@ TEST(SlidingWindowSolver, GaugeHoldsOldestAndKeyframesFixedById) {
   EXPECT_GT((T.t - guess.T_w_b[3].t).norm(), 1e-3);  // the free ones moved
 }
 
+// The odometry holds a remembered scale by fixing a second keyframe at run time (setGaugeFixedOldest), and lets
+// it go with 1 again.
+TEST(SlidingWindowSolver, GaugeOfTheOldestKeyframesChangesAtRunTime) {
+  SceneOptions so;
+  so.landmarks_per_keyframe = 40;
+  const Scene scene = makeScene(isecRig(), so);
+  const WindowGuess guess = perturbedGuess(scene, 0.03, 0.01, 0.1, 7);
+  SlidingWindowSolver solver(scene.rig, smallCapacity());  // default: the oldest keyframe alone
+  fillSolver(solver, scene, guess);
+  EXPECT_EQ(solver.setGaugeFixedOldest(-1), Status::InvalidValue);
+  ASSERT_EQ(solver.setGaugeFixedOldest(2), Status::Ok);
+  EXPECT_FALSE(solver.solve(20).failed);
+  SE3 T;
+  for (int k : {0, 1}) {
+    solver.keyframePose(k, T);
+    EXPECT_EQ(T.t, guess.T_w_b[k].t) << k;
+  }
+  ASSERT_EQ(solver.setGaugeFixedOldest(1), Status::Ok);
+  EXPECT_FALSE(solver.solve(20).failed);
+  solver.keyframePose(0, T);
+  EXPECT_EQ(T.t, guess.T_w_b[0].t);
+  solver.keyframePose(1, T);
+  EXPECT_GT((T.t - guess.T_w_b[1].t).norm(), 1e-3);  // free again: it moves
+}
+
 TEST(SlidingWindowSolver, SymbolicAnalysisRedoneOnlyWhenStructureChanges) {
   SceneOptions so;
   so.landmarks_per_keyframe = 40;

@@ -124,7 +124,10 @@ TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
   EXPECT_GT(std::abs(scale_before - 1.0), 0.05) << "the start is up to scale: its unit is arbitrary";
   ASSERT_GE(after.size(), 100u);
   EXPECT_NEAR(scale_after, 1.0, 0.05);
-  EXPECT_LT(ate_after, 0.1);
+  // The window holds the scale from convergence on (remembered, not re-pulled by every turn): 0.16 m here (scale
+  // 1.042), where a free window reached 0.07 m (0.993) on these exact data; but on the rendered 33 cm rig a free
+  // window shrank the map to a tenth on a straight stretch (BENCHMARKS.md section 1).
+  EXPECT_LT(ate_after, 0.2);
 }
 
 TEST(OdometrySynthetic, OneCameraUpToScale) {

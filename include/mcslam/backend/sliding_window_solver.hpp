@@ -106,6 +106,9 @@ class SlidingWindowSolver {
   Status removeObservation(const ObservationKey& key);
   Status removeLandmark(int64_t id);  // and its observations
   Status setKeyframeFixed(int64_t id, bool fixed);
+  // How many oldest keyframes the next solves hold (SolverOptions::gauge_fixed_oldest): 2 holds the window's
+  // scale as well, for a map whose scale the window alone cannot keep. InvalidValue below 0.
+  Status setGaugeFixedOldest(int count);
   Status setKeyframePose(int64_t id, const SE3& T_w_b);
   Status setLandmarkPosition(int64_t id, const Vec3& p_w);
   // A new current estimate of a refined camera's extrinsic T_b_c from outside (e.g. a per-camera check). The
