@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""Local scale of a trajectory: estimated distance over N frames divided by the true one.
+
+A whole-run Sim(3) scale hides a map whose unit drifts (a rig without overlap, one camera); this prints how the
+scale wanders along the run. Pairs whose true distance is under --min-distance are skipped (a turn in place says
+nothing of the scale). Poses are matched by timestamp (TUM or EuRoC ground truth, seconds or nanoseconds).
+
+  tools/eval/local_scale.py DATASET/groundtruth.txt run.tum [--frames 40] [--series]
+"""
+import argparse
+import math
+import sys
+
+
+def load(path):
+    poses = {}
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            if line.startswith('#') or not line.strip():
+                continue
+            v = line.replace(',', ' ').split()
+            try:
+                t = float(v[0])
+                p = tuple(float(x) for x in v[1:4])
+            except (ValueError, IndexError):
+                sys.exit(f"{path}:{n}: expected 'timestamp x y z ...', got: {line.strip()[:60]}")
+            if t > 1e12:  # nanoseconds (EuRoC)
+                t *= 1e-9
+            poses[round(t, 3)] = p
+    return poses
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('groundtruth')
+    ap.add_argument('estimate')
+    ap.add_argument('--frames', type=int, default=40, help='distance over this many frames (default 40)')
+    ap.add_argument('--min-distance', type=float, default=0.5, help='metres the truth must move (default 0.5)')
+    ap.add_argument('--series', action='store_true', help='also print the local scale every 20 frames')
+    a = ap.parse_args()
+    gt, est = load(a.groundtruth), load(a.estimate)
+    ts = sorted(t for t in est if t in gt)
+    if len(ts) <= a.frames:
+        sys.exit(f"only {len(ts)} poses of {a.estimate} have a ground-truth pose at the same time (need > {a.frames})")
+    ratios = []
+    for i in range(len(ts) - a.frames):
+        t0, t1 = ts[i], ts[i + a.frames]
+        d_true = math.dist(gt[t0], gt[t1])
+        if d_true < a.min_distance:
+            continue
+        ratios.append((i, math.dist(est[t0], est[t1]) / d_true))
+    if not ratios:
+        sys.exit(f"the truth never moves {a.min_distance} m over {a.frames} frames")
+    if a.series:
+        for i, s in ratios[::20]:
+            print(f"frame {i:5d}  {s:.3f}")
+    s = sorted(r for _, r in ratios)
+    q = lambda f: s[min(len(s) - 1, int(f * len(s)))]
+    within = sum(1 for r in s if abs(r - 1) <= 0.05) / len(s)
+    print(f"local scale over {a.frames} frames ({len(s)} spans): min {s[0]:.3f} p10 {q(0.1):.3f} "
+          f"median {q(0.5):.3f} p90 {q(0.9):.3f} max {s[-1]:.3f}; within 5%: {100 * within:.1f}% of the spans")
+
+
+if __name__ == '__main__':
+    main()
