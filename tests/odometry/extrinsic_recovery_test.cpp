@@ -16,8 +16,6 @@ using namespace mcslam;
 
 namespace {
 
-Rig isec() { return loadKalibrRig(test::dataPath("calib/isec_5cam_camchain.yaml")); }
-
 // What `mcslam-rig perturb` does: a translation along one direction, a rotation about one axis.
 Rig perturbed(const Rig& rig, int cam, double translation_m, double rotation_deg) {
   Rig out = rig;
@@ -73,7 +71,7 @@ Outcome run(const Rig& truth, const Rig& calibration) {
 }
 
 void expectRecovered(double translation_m, double rotation_deg, uint64_t min_reestimations) {
-  const Rig truth = isec();
+  const Rig truth = test::isecRig();
   const Rig calibration = perturbed(truth, 3, translation_m, rotation_deg);
   double mm = 0, deg = 0;
   extrinsicError(truth, calibration, 3, mm, deg);
@@ -102,7 +100,7 @@ void expectRecovered(double translation_m, double rotation_deg, uint64_t min_ree
 TEST(OdometryExtrinsics, TwoCentimetresAndOneDegreeAreRecoveredThroughTheOdometry) { expectRecovered(0.02, 1.0, 0); }
 
 TEST(OdometryExtrinsics, ExactCalibrationStaysPutWithRefinementOn) {
-  const Rig truth = isec();
+  const Rig truth = test::isecRig();
   const Outcome r = run(truth, truth);
   for (int c = 1; c < truth.size(); ++c) {
     double mm = 0, deg = 0;

@@ -5,26 +5,12 @@
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/odometry/scale_estimator.hpp"
+#include "synthetic_sequence.hpp"
 #include "test_support.hpp"
 
 using namespace mcslam;
 
 namespace {
-
-// The front camera of the isec rig and two cameras looking left and right 10 cm behind it.
-Rig nonOverlapping3() {
-  const Rig full = loadKalibrRig(test::dataPath("calib/isec_5cam_camchain.yaml"));
-  Rig rig;
-  RigCamera front = full.cameras[2];
-  front.T_b_c = SE3();
-  rig.cameras.push_back(front);
-  for (double yaw : {-M_PI / 2, M_PI / 2}) {
-    RigCamera side = front;
-    side.T_b_c = SE3(Eigen::AngleAxisd(yaw, Vec3::UnitY()).toRotationMatrix(), Vec3(0.0, 0.0, -0.1));
-    rig.cameras.push_back(side);
-  }
-  return rig;
-}
 
 // A window of 8 keyframes over 1 m of travel (body: y down, z forward), turning `turn_deg` in all, with
 // points 2-6 m around; every keyframe observes every point that projects, with `noise_px`. The map then
@@ -78,7 +64,7 @@ void buildWindow(const Rig& rig, Map& map, double turn_deg, double map_scale, do
 
 // The estimator finds the factor that makes a wrongly scaled window metric when the window turns.
 TEST(ScaleEstimator, FindsTheMetricScaleOfATurningWindow) {
-  const Rig rig = nonOverlapping3();
+  const Rig rig = test::nonOverlappingRig3();
   for (double map_scale : {0.4, 1.0, 2.5}) {
     Map map(rig, 2000, 14, 4000);
     buildWindow(rig, map, 60.0, map_scale, 0.5);
@@ -95,7 +81,7 @@ TEST(ScaleEstimator, FindsTheMetricScaleOfATurningWindow) {
 // Without rotation the lever arms move with the body and the scale stays unknown: a large sigma, never a
 // confident wrong answer.
 TEST(ScaleEstimator, StraightWindowLeavesTheScaleOpen) {
-  const Rig rig = nonOverlapping3();
+  const Rig rig = test::nonOverlappingRig3();
   Map map(rig, 2000, 14, 4000);
   buildWindow(rig, map, 0.0, 2.5, 0.5);
   ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 1.2f, 8);

@@ -5,7 +5,27 @@
 #include <cmath>
 #include <map>
 
+#include "mcslam/calib/calibration_io.hpp"
+#include "test_support.hpp"
+
 namespace mcslam::test {
+
+Rig isecRig() { return loadKalibrRig(dataPath("calib/isec_5cam_camchain.yaml")); }
+
+Rig nonOverlappingRig3() {
+  const Rig full = isecRig();
+  Rig rig;
+  RigCamera front = full.cameras[2];
+  front.T_b_c = SE3();
+  rig.cameras.push_back(front);
+  for (double yaw : {-M_PI / 2, M_PI / 2}) {
+    RigCamera side = front;
+    side.T_b_c = SE3(Eigen::AngleAxisd(yaw, Vec3::UnitY()).toRotationMatrix(), Vec3(0.0, 0.0, -0.1));
+    rig.cameras.push_back(side);
+  }
+  for (int i = 0; i < rig.size(); ++i) rig.cameras[i].name = "cam" + std::to_string(i);
+  return rig;
+}
 
 namespace {
 // World: z up. Body: camera-like (x right, y down, z forward), moving in the horizontal plane.

@@ -12,6 +12,11 @@
 
 namespace mcslam::test {
 
+// The paper's 5-camera rig (its Kalibr calibration), and from it a rig without overlap: its centre front camera
+// and two cameras looking left and right from 10 cm behind it.
+Rig isecRig();
+Rig nonOverlappingRig3();
+
 struct SyntheticSequenceOptions {
   int frames = 200;
   double rate_hz = 10.0;
