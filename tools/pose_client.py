@@ -4,7 +4,7 @@
 Written from docs/pose-protocol.md alone, with the Python standard library only, to show that the
 document is enough. Output lines match mcslam-udp-echo / mcslam-shm-echo:
 
-  seq 12 frame 12 t 1403636579.763555584 state tracking valid 1 kf 0 quality 0.830 p <x y z> q <x y z w>
+  seq 12 frame 12 t 1403636579.763555584 state tracking valid 1 kf 0 unscaled 0 quality 0.830 p <x y z> q <x y z w>
 
 Usage: pose_client.py [--bind 0.0.0.0] [--port 9870] [--count N] [--timeout S]
 """
@@ -21,6 +21,7 @@ SIZE = 104
 TRACKING = {0: "not_initialized", 1: "tracking", 2: "lost"}
 FLAG_VALID = 1
 FLAG_KEYFRAME = 2
+FLAG_UNSCALED = 4  # position in an arbitrary unit, not metres
 
 
 def decode(data):
@@ -41,6 +42,7 @@ def decode(data):
         "position": (px, py, pz), "orientation": (qx, qy, qz, qw),
         "tracking": TRACKING.get(state, "unknown"),
         "valid": bool(flags & FLAG_VALID), "keyframe": bool(flags & FLAG_KEYFRAME),
+        "unscaled": bool(flags & FLAG_UNSCALED),
         "quality": quality,
     }
 
@@ -49,8 +51,9 @@ def format_pose(p):
     t = p["capture_time_ns"]
     whole = abs(t) // 1000000000  # truncated toward zero, as C's integer division
     seconds = "%d.%09d" % (-whole if t < 0 else whole, abs(t) % 1000000000)
-    return ("seq %d frame %d t %s state %s valid %d kf %d quality %.3f p %s q %s" % (
-        p["sequence"], p["frame_sequence"], seconds, p["tracking"], p["valid"], p["keyframe"], p["quality"],
+    return ("seq %d frame %d t %s state %s valid %d kf %d unscaled %d quality %.3f p %s q %s" % (
+        p["sequence"], p["frame_sequence"], seconds, p["tracking"], p["valid"], p["keyframe"], p["unscaled"],
+        p["quality"],
         " ".join("%.17g" % v for v in p["position"]), " ".join("%.17g" % v for v in p["orientation"])))
 
 

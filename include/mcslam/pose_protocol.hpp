@@ -19,6 +19,9 @@ enum class Tracking : uint8_t { NotInitialized = 0, Tracking = 1, Lost = 2 };
 
 inline constexpr uint8_t kFlagValid = 1u << 0;     // position/orientation hold an estimate
 inline constexpr uint8_t kFlagKeyframe = 1u << 1;  // the pipeline made this frame a keyframe
+// The position's unit is arbitrary, not metres: one camera, or a rig without overlapping cameras whose map has
+// not yet found its metric scale (it starts up to scale and finds it in turns). Orientation is unaffected.
+inline constexpr uint8_t kFlagUnscaled = 1u << 2;
 
 struct PoseRecord {
   uint64_t sequence = 0;        // publish counter, 1 for the first pose of a daemon run, +1 per pose
@@ -33,6 +36,7 @@ struct PoseRecord {
 
   bool valid() const { return (flags & kFlagValid) != 0; }
   bool keyframe() const { return (flags & kFlagKeyframe) != 0; }
+  bool unscaled() const { return (flags & kFlagUnscaled) != 0; }
 };
 
 enum class DecodeStatus { Ok, TooShort, BadMagic, BadVersion, BadSize };

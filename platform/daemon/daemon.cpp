@@ -293,7 +293,8 @@ void Daemon::publishPose(const PoseSlot& slot) {
   r.orientation[2] = q.z();
   r.orientation[3] = q.w();
   r.tracking = static_cast<pose::Tracking>(e.state);
-  r.flags = static_cast<uint8_t>((e.valid ? pose::kFlagValid : 0) | (e.is_keyframe ? pose::kFlagKeyframe : 0));
+  r.flags = static_cast<uint8_t>((e.valid ? pose::kFlagValid : 0) | (e.is_keyframe ? pose::kFlagKeyframe : 0) |
+                                 (e.metric ? 0 : pose::kFlagUnscaled));
   r.quality = e.quality;
   if (shm_) shm_->publish(r);
   udp_.send(r);

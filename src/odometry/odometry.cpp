@@ -87,6 +87,12 @@ void Odometry::useExtrinsic(int cam, const SE3& T_b_c) {
 }
 
 void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
+  processFrame(frame, frame_index, out);
+  // As of the end of the frame: a scale that converged in it already rescaled this pose.
+  out.metric = scale_converged_ && rig_.size() > 1;
+}
+
+void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
   timing_ = OdometryTiming{};
   ++stats_.frames;
   out = PoseEstimate{};

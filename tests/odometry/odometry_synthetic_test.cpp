@@ -15,31 +15,14 @@ using namespace mcslam;
 
 namespace {
 
-Rig isec() { return loadKalibrRig(test::dataPath("calib/isec_5cam_camchain.yaml")); }
-
-// The centre front camera and two cameras looking left and right from the same mount.
-Rig nonOverlapping3() {
-  const Rig full = isec();
-  Rig rig;
-  RigCamera front = full.cameras[2];
-  front.T_b_c = SE3();
-  rig.cameras.push_back(front);
-  for (double yaw : {-M_PI / 2, M_PI / 2}) {
-    RigCamera side = front;
-    const Mat3 R = Eigen::AngleAxisd(yaw, Vec3::UnitY()).toRotationMatrix();
-    side.T_b_c = SE3(R, Vec3(0.0, 0.0, -0.1));
-    rig.cameras.push_back(side);
-  }
-  for (int i = 0; i < rig.size(); ++i) rig.cameras[i].name = "cam" + std::to_string(i);
-  return rig;
-}
-
 struct RunResult {
   Trajectory estimate;
   OdometryStats stats;
   double ate = 0;
   double scale = 1;
   uint64_t allocations_after_warmup = 0;
+  int first_metric = -1;     // first tracked frame whose pose says it is metric
+  int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
 };
 
 RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, bool sim3) {
@@ -62,7 +45,14 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
       r.allocations_after_warmup += scope.count();
       if (scope.count() && std::getenv("MCSLAM_DEBUG_ALLOC")) std::printf("frame %d allocs %llu\n", i, (unsigned long long)scope.count());
     }
-    if (pose.valid && pose.state == TrackingState::Tracking) r.estimate.push_back({pose.t, pose.T_w_b});
+    if (pose.valid && pose.state == TrackingState::Tracking) {
+      r.estimate.push_back({pose.t, pose.T_w_b});
+      if (r.first_metric < 0 && pose.metric) r.first_metric = i;
+      if (r.first_metric >= 0) {
+        ++r.tracked_after_metric;
+        r.unscaled_after_metric += pose.metric ? 0 : 1;
+      }
+    }
   }
   odo.flush();
   r.allocations_after_warmup += odo.backendThreadAllocations() - backend_thread_before;
@@ -80,7 +70,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
 
 TEST(OdometrySynthetic, FiveOverlappingCameras) {
   test::SyntheticSequenceOptions so;
-  const RunResult r = runSequence(isec(), so, false);
+  const RunResult r = runSequence(test::isecRig(), so, false);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_EQ(r.stats.initializations, 1u);
   EXPECT_LT(r.ate, 0.05);
@@ -91,9 +81,11 @@ TEST(OdometrySynthetic, FiveOverlappingCameras) {
 
 TEST(OdometrySynthetic, Stereo) {
   test::SyntheticSequenceOptions so;
-  const RunResult r = runSequence(isec().subset({1, 2}), so, false);
+  const RunResult r = runSequence(test::isecRig().subset({1, 2}), so, false);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_LT(r.ate, 0.08);
+  EXPECT_EQ(r.tracked_after_metric, static_cast<int>(r.estimate.size())) << "a metric start: every pose in metres";
+  EXPECT_EQ(r.unscaled_after_metric, 0);
   if (alloc::available()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }
@@ -105,12 +97,15 @@ TEST(OdometrySynthetic, Stereo) {
 TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
   test::SyntheticSequenceOptions so;
   so.frames = 400;
-  const RunResult r = runSequence(nonOverlapping3(), so, true);
+  const RunResult r = runSequence(test::nonOverlappingRig3(), so, true);
   EXPECT_EQ(r.stats.lost, 0u);
   ASSERT_GE(r.stats.scale_converged_frame, 0) << "the map should start up to scale and then converge";
+  // The poses say so: unscaled up to the frame the scale converged in, metric from it on.
+  EXPECT_EQ(r.first_metric, r.stats.scale_converged_frame);
+  EXPECT_EQ(r.unscaled_after_metric, 0);
   EXPECT_GE(r.stats.scale_rescales, 1u);
   EXPECT_LE(r.stats.combined_scale_sigma, OdometryOptions{}.scale_max_sigma);
-  test::SyntheticSequence seq(nonOverlapping3(), so);
+  test::SyntheticSequence seq(test::nonOverlappingRig3(), so);
   const Timestamp t_converged = seq.truth(static_cast<int>(r.stats.scale_converged_frame)).t;
   Trajectory before, after;
   for (const StampedPose& p : r.estimate) (p.t < t_converged ? before : after).push_back(p);
@@ -132,9 +127,10 @@ TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
 
 TEST(OdometrySynthetic, OneCameraUpToScale) {
   test::SyntheticSequenceOptions so;
-  const RunResult r = runSequence(isec().subset({2}), so, true);
+  const RunResult r = runSequence(test::isecRig().subset({2}), so, true);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_GT(r.stats.tracking, 150u);
+  EXPECT_EQ(r.first_metric, -1) << "one camera's poses never are in metres";
   if (alloc::available()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }

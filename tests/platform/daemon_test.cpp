@@ -41,6 +41,7 @@ class FakeProcessor : public FrameProcessor {
     out.valid = out.state == TrackingState::Tracking;
     out.quality = 0.9f;
     out.is_keyframe = f.sequence % 5 == 0;
+    out.metric = f.sequence >= 20;  // as a rig without overlap before its scale converged
   }
 
  private:
@@ -197,6 +198,7 @@ TEST_F(DaemonTest, EveryPoseGoesToSharedMemoryUdpAndTheTrajectoryIdentically) {
     EXPECT_EQ(s.sequence, i + 1);
     EXPECT_EQ(s.frame_sequence, i);
     EXPECT_EQ(s.capture_time_ns, 1000000000000ll + static_cast<int64_t>(i) * 50000000);
+    EXPECT_EQ(s.unscaled(), i < 20) << i;
     if (!s.valid()) continue;
     ++valid;
     ASSERT_LT(row, rows.size());

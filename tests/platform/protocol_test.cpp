@@ -20,7 +20,7 @@ TEST(PoseProtocol, BytesSitAtTheDocumentedOffsetsLittleEndian) {
   r.orientation[2] = 0;
   r.orientation[3] = 1.0;
   r.tracking = Tracking::Lost;
-  r.flags = kFlagValid | kFlagKeyframe;
+  r.flags = kFlagValid | kFlagKeyframe | kFlagUnscaled;
   r.quality = 0.5f;
   uint8_t b[kPacketSize];
   encodePacket(r, b);
@@ -41,7 +41,7 @@ TEST(PoseProtocol, BytesSitAtTheDocumentedOffsetsLittleEndian) {
   EXPECT_EQ(b[48 + 6], 0x04);
   EXPECT_EQ(b[88 + 7], 0x3F);  // qw = 1.0
   EXPECT_EQ(b[96], 2);
-  EXPECT_EQ(b[97], 3);
+  EXPECT_EQ(b[97], 7);
   EXPECT_EQ(b[98], 0);
   EXPECT_EQ(b[99], 0);
   // 0.5f = 0x3F000000

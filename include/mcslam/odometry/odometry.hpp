@@ -94,6 +94,7 @@ class Odometry {
   int poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b);
   bool needKeyframe(const SE3& T_w_b, int inliers, uint64_t frame_index) const;
   int countKeyframeLandmarks(int slot) const;
+  void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
   void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);

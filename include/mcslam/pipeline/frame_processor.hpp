@@ -43,6 +43,9 @@ struct PoseEstimate {
   float quality = 0;         // 0..1: share of expected landmark matches that were inliers
   bool is_keyframe = false;
   bool valid = false;        // T_w_b holds an estimate
+  // T_w_b.t is in metres. False when its unit is arbitrary: one camera, or a rig without overlap whose map
+  // started up to scale and has not yet found it.
+  bool metric = true;
 };
 
 class FrameProcessor {
