@@ -90,3 +90,17 @@ TEST_F(RunLayouts, EveryLayoutGivesTheSameTrajectoryAndItMatchesItsGroundTruth) 
     EXPECT_LT(ape.stats.rmse, 0.02) << layout << ": ATE " << ape.stats.rmse << " m over " << ape.data.ref_path_length << " m";
   }
 }
+
+// A trajectory whose unit is not metres says so: one camera of the pair tracks up to scale, and the runner tells
+// when tracking starts and again at the end; the pair (metric from its first frame) says neither.
+TEST_F(RunLayouts, TheRunnerSaysWhenTheTrajectoryIsNotMetric) {
+  std::string one, pair;
+  const std::string common = bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --frames 30 --out " +
+                             dir_->file("unit.tum");
+  ASSERT_EQ(test::runCommand(common + " --cameras 0", &one), 0) << one;
+  EXPECT_NE(one.find("tracking up to scale (one camera)"), std::string::npos) << one;
+  EXPECT_NE(one.find("one camera: the trajectory's unit is arbitrary"), std::string::npos) << one;
+  ASSERT_EQ(test::runCommand(common, &pair), 0) << pair;
+  EXPECT_EQ(pair.find("up to scale"), std::string::npos) << pair;
+  EXPECT_EQ(pair.find("unit is arbitrary"), std::string::npos) << pair;
+}

@@ -124,6 +124,7 @@ int main(int argc, char** argv) {
     std::future<PreparedFrame> pending;
     if (overlap) pending = std::async(std::launch::async, frontEnd, std::size_t{0});
     bool was_initialized = false;
+    bool last_tracked_unscaled = false;  // the last tracked pose was not in metres
     double ms_avg = 0;
     for (std::size_t i = 0; i < frames; ++i) {
       PreparedFrame prepared = overlap ? pending.get() : frontEnd(i);
@@ -137,8 +138,12 @@ int main(int argc, char** argv) {
       // Losing and regaining track are worth a line of their own (the stats file lists them all).
       const bool unknown_scale = pipeline.odometry().initialized() && !pipeline.odometry().scaleConverged();
       if (report.add(pose, timing, unknown_scale) && !quiet && i > 0) {
-        std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s\n", show ? "\r\033[K" : "", i, toSeconds(pose.t),
-                     trackingStateName(pose.state));
+        // Say when the poses are not in metres (pose.metric): a rig without overlap until its scale is found.
+        const char* unit = pose.state != TrackingState::Tracking || pose.metric ? ""
+                           : unknown_scale ? " up to scale (no two cameras overlap: the scale is searched in turns)"
+                                           : " up to scale (one camera)";
+        std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s%s\n", show ? "\r\033[K" : "", i,
+                     toSeconds(pose.t), trackingStateName(pose.state), unit);
       }
       const bool initialized = pipeline.odometry().initialized();
       if (initialized && !was_initialized && pipeline.odometry().lastInitializationReference() >= 0) {
@@ -149,6 +154,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%smcslam-run: frame %zu: metric scale found (sigma %.1f%%)\n", show ? "\r\033[K" : "", i,
                      100.0 * pipeline.stats().combined_scale_sigma);
       }
+      if (pose.valid && pose.state == TrackingState::Tracking) last_tracked_unscaled = !pose.metric;
       if (pose.is_keyframe) report.noteKeyframes(pipeline.odometry().map());
       ms_avg = i == 0 ? timing.total_ms : 0.95 * ms_avg + 0.05 * timing.total_ms;
       if (show && (i % 5 == 0 || i + 1 == frames)) progress(i + 1, frames, ms_avg, pose);
@@ -169,6 +175,10 @@ int main(int argc, char** argv) {
                    static_cast<unsigned long long>(s.frames), wall, static_cast<unsigned long long>(s.tracking),
                    static_cast<unsigned long long>(s.lost), static_cast<unsigned long long>(s.not_initialized),
                    static_cast<unsigned long long>(s.keyframes));
+      if (last_tracked_unscaled) {
+        std::fprintf(stderr, "mcslam-run: %s: the trajectory's unit is arbitrary (evaluate it with --align sim3)\n",
+                     pipeline.odometry().trackingRig().size() == 1 ? "one camera" : "the metric scale was not found");
+      }
     }
   } catch (const InputError& e) {
     std::fprintf(stderr, "mcslam-run: %s\n", e.what());
