@@ -270,6 +270,7 @@ void Daemon::handOver(PoseSlot& out) {
   if (pose_ring_.publish()) pose_drops_.fetch_add(1, std::memory_order_relaxed);
   pose_bell_.ring();
   tracking_.store(static_cast<uint8_t>(out.estimate.state), std::memory_order_relaxed);
+  unscaled_.store(out.estimate.valid && !out.estimate.metric, std::memory_order_relaxed);
   const uint64_t done = processed_.fetch_add(1, std::memory_order_release) + 1;
   if (!warm_.load(std::memory_order_relaxed) && done >= warmup) {
     processed_at_warmup_.store(done, std::memory_order_relaxed);
@@ -353,6 +354,7 @@ DaemonStats Daemon::stats() const {
   s.trajectory_poses = trajectory_->written();
   s.trajectory_errors = trajectory_->errors();
   s.tracking = static_cast<TrackingState>(tracking_.load());
+  s.unscaled = unscaled_.load();
   s.latency_count = latency_.count();
   s.latency_p50_ns = latency_.percentileNs(0.5);
   s.latency_p99_ns = latency_.percentileNs(0.99);

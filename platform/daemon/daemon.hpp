@@ -37,6 +37,7 @@ struct DaemonStats {
   uint64_t processed = 0, published = 0, pose_drops = 0;
   uint64_t udp_sent = 0, udp_failed = 0, trajectory_poses = 0, trajectory_errors = 0;
   TrackingState tracking = TrackingState::NotInitialized;
+  bool unscaled = false;  // the last pose's position is not in metres (PoseEstimate::metric)
   uint64_t latency_count = 0;
   int64_t latency_p50_ns = 0, latency_p99_ns = 0;  // trigger -> published
   bool warm = false;
@@ -128,6 +129,7 @@ class Daemon {
 
   std::atomic<uint64_t> rig_frames_{0}, rig_drops_{0}, published_{0}, pose_drops_{0};
   std::atomic<uint8_t> tracking_{0};
+  std::atomic<bool> unscaled_{false};
   std::atomic<bool> warm_{false};
   std::atomic<uint64_t> processed_at_warmup_{0};
   LatencyHistogram latency_;

@@ -18,9 +18,10 @@ void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char
                                ? static_cast<double>(s.allocations_after_warmup) / static_cast<double>(s.frames_after_warmup)
                                : 0.0;
   std::snprintf(out, size,
-                "%.1f Hz, %s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
+                "%.1f Hz, %s%s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
                 "cameras %s%s",
-                rate_hz, trackingStateName(s.tracking), static_cast<unsigned long long>(s.processed),
+                rate_hz, trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "",
+                static_cast<unsigned long long>(s.processed),
                 static_cast<unsigned long long>(s.rig_drops + s.camera_drops),
                 static_cast<unsigned long long>(s.partial_frames), static_cast<double>(s.latency_p50_ns) * 1e-6,
                 per_frame, s.warm ? "" : " (warming up)", health, s.source_finished ? ", source finished" : "");
@@ -49,6 +50,7 @@ int runDaemon(const DaemonConfig& config) {
   uint64_t last_processed = 0, processed_at_status = 0;
   int64_t last_progress = monotonicNowNs(), last_status = monotonicNowNs();
   TrackingState last_state = TrackingState::NotInitialized;
+  bool last_unscaled = false;
   uint64_t last_lost = 0;
   bool stall_reported = false;
   int signal_number = 0;
@@ -80,9 +82,12 @@ int runDaemon(const DaemonConfig& config) {
 
     if (s.tracking != last_state) {
       if (s.tracking == TrackingState::Lost) spdlog::warn("tracking lost (frame {})", s.processed);
-      else spdlog::info("tracking state: {}", trackingStateName(s.tracking));
+      else spdlog::info("tracking state: {}{}", trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "");
       last_state = s.tracking;
+    } else if (last_unscaled && !s.unscaled && s.tracking == TrackingState::Tracking) {
+      spdlog::info("metric scale found (frame {}): positions are in metres from here on", s.processed);
     }
+    last_unscaled = s.unscaled;
     if (s.lost_events > last_lost) {
       spdlog::warn("camera lost events: {} ({})", s.lost_events, health);
       last_lost = s.lost_events;

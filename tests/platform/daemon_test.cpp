@@ -15,6 +15,7 @@
 
 #include "daemon/daemon.hpp"
 #include "daemon/daemon_config.hpp"
+#include "daemon/supervisor.hpp"
 #include "daemon_fixture.hpp"
 #include "sim_dataset_fixture.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
@@ -180,6 +181,7 @@ TEST_F(DaemonTest, EveryPoseGoesToSharedMemoryUdpAndTheTrajectoryIdentically) {
     const DaemonStats st = d.stats();
     EXPECT_EQ(st.rig_drops, 0u);  // "fastest" is lossless
     EXPECT_EQ(st.partial_frames, 0u);
+    EXPECT_FALSE(st.unscaled);  // the last pose (frame 39) is metric
     trajectory = d.trajectoryPath();
   }
   from_udp = drainUdp(rx);
@@ -332,4 +334,16 @@ TEST_F(DaemonTest, SimSourceDeliversTheSimulatorsFramesWholeAndInOrder) {
     dataset.loadImages(i, images, present, nullptr);
     for (int k = 0; k < 2; ++k) EXPECT_EQ(seen[i].hashes[k], imageHash(images[k].view())) << "frame " << i << " camera " << k;
   }
+}
+
+// The status line (systemd STATUS= and the log) says when the poses are not in metres.
+TEST(DaemonStatus, TheStatusLineSaysWhenPositionsAreUpToScale) {
+  DaemonStats s;
+  s.tracking = TrackingState::Tracking;
+  char line[400];
+  formatStatus(s, 10.0, "ok", line, sizeof(line));
+  EXPECT_EQ(std::string(line).find("up to scale"), std::string::npos) << line;
+  s.unscaled = true;
+  formatStatus(s, 10.0, "ok", line, sizeof(line));
+  EXPECT_NE(std::string(line).find("tracking (up to scale)"), std::string::npos) << line;
 }
