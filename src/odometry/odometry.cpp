@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include <spdlog/spdlog.h>
+
 #include "extrinsic_check.hpp"
 #include "mcslam/odometry/initializer.hpp"
 #include "mcslam/odometry/local_mapper.hpp"
@@ -221,12 +223,10 @@ void Odometry::estimateScale() {
   if (!scale_filter_->add(std::log(e.scale), e.relative_sigma, e.keyframes, new_keyframes)) return;  // an outlier
   const double x = scale_filter_->correction(), sigma = scale_filter_->sigma();
   stats_.combined_scale_sigma = sigma;
-  if (std::getenv("MCSLAM_DEBUG_SCALE")) {  // one line per estimate, for studies against ground truth
-    std::fprintf(stderr, "scale frame %llu: window %.4f sigma %.4f (%d keyframes, %d landmarks), "
-                 "combined %.4f sigma %.4f\n",
-                 static_cast<unsigned long long>(frame_index_), e.scale, e.relative_sigma, e.keyframes, e.landmarks,
-                 std::exp(x), sigma);
-  }
+  // One line per estimate, for studies against ground truth (mcslam-run --log-level debug).
+  spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks), combined "
+                "{:.4f} sigma {:.4f}", frame_index_, e.scale, e.relative_sigma, e.keyframes, e.landmarks, std::exp(x),
+                sigma);
   // Until the combined sigma reaches the bound nothing is applied (the back-end's own window pulls the scale
   // meanwhile); afterwards a correction 3 sigma away from 1 is.
   const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma;

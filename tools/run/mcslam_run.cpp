@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
 #include <chrono>
 #include <cstdio>
 #include <future>
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
   CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
   std::string dataset_dir, calibration_path, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
   bool quiet = false, print_config = false, overlap = false;
+  std::string log_level = "info";
   std::size_t max_frames = 0;
   app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
       ->required();
@@ -81,12 +83,16 @@ int main(int argc, char** argv) {
   app.add_option("--extrinsics", extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", quiet, "No progress bar");
+  app.add_option("--log-level", log_level, "Log of the pipeline's events (debug: also each scale estimate of a rig "
+                                           "without overlap)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.add_flag("--overlap", overlap,
                "Run the front-end of the next frame while the odometry works on this one (same output; on our 2-core "
                "machine 15-20% faster when nothing else runs, slower under competing load: see BENCHMARKS.md)");
   app.add_flag("--print-config", print_config,
                "Print the effective `slam:` configuration (defaults, --config, this dataset's rig) and exit");
   CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(log_level));
 
   try {
     DatasetOptions dopt;
