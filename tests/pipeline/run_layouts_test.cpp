@@ -58,6 +58,12 @@ double maxPositionDifference(const Trajectory& a, const Trajectory& b) {
   return worst;
 }
 
+// The integer after the first "key": in a JSON text (-1 when absent).
+long jsonInt(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\":");
+  return at == std::string::npos ? -1 : std::stol(json.substr(at + key.size() + 3));
+}
+
 }  // namespace
 
 TEST_F(RunLayouts, EveryLayoutGivesTheSameTrajectoryAndItMatchesItsGroundTruth) {
@@ -96,11 +102,17 @@ TEST_F(RunLayouts, EveryLayoutGivesTheSameTrajectoryAndItMatchesItsGroundTruth) 
 TEST_F(RunLayouts, TheRunnerSaysWhenTheTrajectoryIsNotMetric) {
   std::string one, pair;
   const std::string common = bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --frames 30 --out " +
-                             dir_->file("unit.tum");
+                             dir_->file("unit.tum") + " --stats " + dir_->file("unit.json");
   ASSERT_EQ(test::runCommand(common + " --cameras 0", &one), 0) << one;
   EXPECT_NE(one.find("tracking up to scale (one camera)"), std::string::npos) << one;
   EXPECT_NE(one.find("one camera: the trajectory's unit is arbitrary"), std::string::npos) << one;
+  // Every frame with a pose is counted up to scale: those tracked and those interpolated before initialization.
+  const std::string one_stats = test::readFile(dir_->file("unit.json"));
+  EXPECT_EQ(jsonInt(one_stats, "frames_unknown_scale"),
+            jsonInt(one_stats, "tracking") + jsonInt(one_stats, "interpolated_before_initialization")) << one_stats;
+  EXPECT_GT(jsonInt(one_stats, "frames_unknown_scale"), 20) << one_stats;
   ASSERT_EQ(test::runCommand(common, &pair), 0) << pair;
   EXPECT_EQ(pair.find("up to scale"), std::string::npos) << pair;
   EXPECT_EQ(pair.find("unit is arbitrary"), std::string::npos) << pair;
+  EXPECT_EQ(jsonInt(test::readFile(dir_->file("unit.json")), "frames_unknown_scale"), 0);
 }

@@ -142,12 +142,12 @@ int main(int argc, char** argv) {
       pipeline.track(buffers[i % 2], i, ds.frames()[i].t, pose, timing);
       timing.total_ms = prepared.wall_ms + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - track_start).count();
       // Losing and regaining track are worth a line of their own (the stats file lists them all).
-      const bool unknown_scale = pipeline.odometry().initialized() && !pipeline.odometry().scaleConverged();
-      if (report.add(pose, timing, unknown_scale) && !quiet && i > 0) {
+      if (report.add(pose, timing) && !quiet && i > 0) {
         // Say when the poses are not in metres (pose.metric): a rig without overlap until its scale is found.
         const char* unit = pose.state != TrackingState::Tracking || pose.metric ? ""
-                           : unknown_scale ? " up to scale (no two cameras overlap: the scale is searched in turns)"
-                                           : " up to scale (one camera)";
+                           : pipeline.odometry().trackingRig().size() == 1
+                               ? " up to scale (one camera)"
+                               : " up to scale (no two cameras overlap: the scale is searched in turns)";
         std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s%s\n", show ? "\r\033[K" : "", i,
                      toSeconds(pose.t), trackingStateName(pose.state), unit);
       }

@@ -9,9 +9,9 @@
 
 namespace mcslam::run {
 
-bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing, bool unknown_scale) {
+bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
   FrameRecord r;
-  r.unknown_scale = unknown_scale && pose.valid;
+  r.unknown_scale = pose.valid && !pose.metric;
   r.t = pose.t;
   r.pose = pose;
   r.timing = timing;
@@ -121,7 +121,8 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.endArray();
   j.key("interpolated_before_initialization").value(interpolated);
   // A rig without overlap starts up to scale: its poses have an arbitrary unit until the back-end's window
-  // fixes the scale (frame of convergence; -1: the map started metric, or never converged).
+  // fixes the scale (frame of convergence; -1: the map started metric, or never converged). One camera's
+  // poses are all up to scale (frames_unknown_scale counts them).
   j.key("scale").beginObject();
   j.key("converged_frame").value(static_cast<long long>(s.scale_converged_frame));
   j.key("frames_unknown_scale").value(unknown_scale);

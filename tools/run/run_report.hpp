@@ -14,7 +14,7 @@ struct FrameRecord {
   PoseEstimate pose;
   PipelineTiming timing;
   bool interpolated = false;  // filled in after a two-frame initialization
-  bool unknown_scale = false;  // tracked in a map whose metric scale was not yet known (rig without overlap)
+  bool unknown_scale = false;  // its position is not in metres (one camera; a rig without overlap before its scale)
 };
 
 // A frame whose tracking state differs from the frame before (the first frame counts as one).
@@ -27,7 +27,7 @@ struct StateChange {
 class RunReport {
  public:
   // Returns true when the frame's tracking state differs from the previous frame's (see stateChanges()).
-  bool add(const PoseEstimate& pose, const PipelineTiming& timing, bool unknown_scale = false);
+  bool add(const PoseEstimate& pose, const PipelineTiming& timing);
   // After a two-frame initialization at frame `init_index` from reference frame `reference_index`, the
   // frames in between get poses interpolated between the two (they had none of their own).
   void backfill(uint64_t reference_index, uint64_t init_index);
