@@ -85,7 +85,7 @@ int runDaemon(const DaemonConfig& config) {
       else spdlog::info("tracking state: {}{}", trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "");
       last_state = s.tracking;
     } else if (last_unscaled && !s.unscaled && s.tracking == TrackingState::Tracking) {
-      spdlog::info("metric scale found (frame {}): positions are in metres from here on", s.processed);
+      spdlog::info("metric scale found (by frame {}): positions are in metres from here on", s.processed);
     }
     last_unscaled = s.unscaled;
     if (s.lost_events > last_lost) {
