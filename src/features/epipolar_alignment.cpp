@@ -2,127 +2,218 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace mcslam {
 
 namespace {
 
-constexpr int kMaxHalf = 6;
-constexpr int kMaxSide = 2 * kMaxHalf + 3;  // the template keeps a ring more for its central differences
-
-// Bilinear sample; the caller has checked that (x, y) and (x + 1, y + 1) are inside.
-inline float sample(const ImageView& im, float x, float y) {
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const float ax = x - static_cast<float>(x0), ay = y - static_cast<float>(y0);
-  const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(y0) * im.stride + x0;
-  const float top = p[0] + ax * (static_cast<float>(p[1]) - p[0]);
-  const float bottom = p[im.stride] + ax * (static_cast<float>(p[im.stride + 1]) - p[im.stride]);
-  return top + ay * (bottom - top);
-}
+constexpr int kMaxHalf = AlignmentTemplate::kMaxHalf;
+constexpr int kMaxPadded = AlignmentTemplate::kMaxPadded;
+constexpr int kMaxGrid = (2 * kMaxHalf + 3) * (2 * kMaxHalf + 3);  // the template's grid keeps a ring more
+constexpr int kMaxGridPadded = (kMaxGrid + 3) / 4 * 4;
 
 bool inside(const ImageView& im, double x, double y, double ex, double ey) {
   return x - ex >= 0 && y - ey >= 0 && x + ex < im.width - 1 && y + ey < im.height - 1;
 }
 
+// Bilinear samples at count positions (a multiple of 4), written to out; the caller has checked that every
+// (x, y) and (x + 1, y + 1) is inside. Four at a time: the pixel pairs of both rows are read as one 32-bit word
+// per sample and split into lanes, so the loads, not the arithmetic, are the per-sample work (a frame aligns
+// thousands of partners, each in a few iterations of 49 samples).
+void sampleBilinear(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
+  for (int g = 0; g < count; g += 4) {
+#if defined(__SSE2__)
+    const __m128 x = _mm_loadu_ps(xs + g), y = _mm_loadu_ps(ys + g);
+    const __m128i xi = _mm_cvttps_epi32(x), yi = _mm_cvttps_epi32(y);  // positions are >= 0: truncation floors
+    const __m128 ax = _mm_sub_ps(x, _mm_cvtepi32_ps(xi)), ay = _mm_sub_ps(y, _mm_cvtepi32_ps(yi));
+    alignas(16) int32_t xk[4], yk[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(xk), xi);
+    _mm_store_si128(reinterpret_cast<__m128i*>(yk), yi);
+    auto word = [&](int k) {
+      const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(yk[k]) * im.stride + xk[k];
+      uint16_t top, bottom;
+      std::memcpy(&top, p, 2);
+      std::memcpy(&bottom, p + im.stride, 2);
+      return static_cast<int>(static_cast<uint32_t>(top) | (static_cast<uint32_t>(bottom) << 16));
+    };
+    // Built in registers: four 32-bit stores read back as one 128-bit load would stall store forwarding.
+    const __m128i w = _mm_set_epi32(word(3), word(2), word(1), word(0));
+    const __m128i byte = _mm_set1_epi32(0xFF);
+    const __m128 p00 = _mm_cvtepi32_ps(_mm_and_si128(w, byte));
+    const __m128 p10 = _mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, 8), byte));
+    const __m128 p01 = _mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, 16), byte));
+    const __m128 p11 = _mm_cvtepi32_ps(_mm_srli_epi32(w, 24));
+    const __m128 top = _mm_add_ps(p00, _mm_mul_ps(ax, _mm_sub_ps(p10, p00)));
+    const __m128 bottom = _mm_add_ps(p01, _mm_mul_ps(ax, _mm_sub_ps(p11, p01)));
+    _mm_storeu_ps(out + g, _mm_add_ps(top, _mm_mul_ps(ay, _mm_sub_ps(bottom, top))));
+#else
+    for (int k = g; k < g + 4; ++k) {
+      const int x0 = static_cast<int>(xs[k]), y0 = static_cast<int>(ys[k]);
+      const float ax = xs[k] - static_cast<float>(x0), ay = ys[k] - static_cast<float>(y0);
+      const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(y0) * im.stride + x0;
+      const float p00 = p[0], p10 = p[1], p01 = p[im.stride], p11 = p[im.stride + 1];
+      const float top = p00 + ax * (p10 - p00), bottom = p01 + ax * (p11 - p01);
+      out[k] = top + ay * (bottom - top);
+    }
+#endif
+  }
+}
+
+// Sums of products over padded arrays, in 4 lanes added in a fixed order (the result does not depend on the
+// thread or the call site).
+struct Sums {
+  double s[3];
+};
+Sums dot3(const float* d, const float* a, const float* b, int padded) {
+  float l0[4] = {}, l1[4] = {}, l2[4] = {};
+  for (int g = 0; g < padded; g += 4) {
+    for (int k = 0; k < 4; ++k) {
+      const float v = d[g + k];
+      l0[k] += v * v;
+      l1[k] += v * a[g + k];
+      l2[k] += v * b[g + k];
+    }
+  }
+  auto total = [](const float* l) { return (static_cast<double>(l[0]) + l[1]) + (static_cast<double>(l[2]) + l[3]); };
+  return {{total(l0), total(l1), total(l2)}};
+}
+
+double sum(const float* v, int padded) {
+  float l[4] = {};
+  for (int g = 0; g < padded; g += 4) {
+    for (int k = 0; k < 4; ++k) l[k] += v[g + k];
+  }
+  return (static_cast<double>(l[0]) + l[1]) + (static_cast<double>(l[2]) + l[3]);
+}
+
 }  // namespace
 
-EpipolarAlignment alignAlongEpipolar(const ImageView& ref, const Vec2& ref_uv, const ImageView& image, const Vec2& uv0,
-                                     const Vec2& direction, const Mat2& A, double spacing, double partner_spacing,
+bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spacing,
+                           const EpipolarAlignmentOptions& options, AlignmentTemplate& t) {
+  t.ok = false;
+  const int h = std::clamp(options.half_size, 1, kMaxHalf);
+  t.half = h;
+  t.samples = (2 * h + 1) * (2 * h + 1);
+  t.padded = (t.samples + 3) / 4 * 4;
+  t.spacing = spacing;
+  t.uv = ref_uv;
+  if (ref.empty() || !inside(ref, ref_uv.x(), ref_uv.y(), spacing * (h + 1), spacing * (h + 1))) return false;
+  // The reference patch on its grid, one ring more for the central differences.
+  const int side = 2 * h + 3, grid = side * side, grid_padded = (grid + 3) / 4 * 4;
+  alignas(16) float gx[kMaxGridPadded], gy[kMaxGridPadded], g[kMaxGridPadded];
+  for (int k = 0; k < grid_padded; ++k) {
+    const int i = k < grid ? k % side : h + 1, j = k < grid ? k / side : h + 1;  // padding: the centre
+    gx[k] = static_cast<float>(ref_uv.x() + spacing * (i - h - 1));
+    gy[k] = static_cast<float>(ref_uv.y() + spacing * (j - h - 1));
+  }
+  sampleBilinear(ref, gx, gy, grid_padded, g);
+  const float inv_2s = static_cast<float>(1.0 / (2 * spacing));
+  int k = 0;
+  for (int j = 1; j < side - 1; ++j) {
+    for (int i = 1; i < side - 1; ++i, ++k) {
+      const float* c = g + j * side + i;
+      t.value[k] = c[0];
+      t.dx[k] = (c[1] - c[-1]) * inv_2s;
+      t.dy[k] = (c[side] - c[-side]) * inv_2s;
+    }
+  }
+  for (; k < t.padded; ++k) t.value[k] = t.dx[k] = t.dy[k] = 0;
+  const double n = t.samples;
+  const float mean_v = static_cast<float>(sum(t.value, t.padded) / n);
+  const float mean_x = static_cast<float>(sum(t.dx, t.padded) / n), mean_y = static_cast<float>(sum(t.dy, t.padded) / n);
+  for (k = 0; k < t.samples; ++k) {
+    t.value[k] -= mean_v;
+    t.dx[k] -= mean_x;
+    t.dy[k] -= mean_y;
+  }
+  // Zero mean, unit norm; the derivatives' means are removed with the template's own (the residual is blind to a
+  // constant).
+  const double var = dot3(t.value, t.value, t.value, t.padded).s[0];
+  if (!(var > 1e-6)) return false;
+  const float inv_norm = static_cast<float>(1.0 / std::sqrt(var));
+  for (k = 0; k < t.samples; ++k) {
+    t.value[k] *= inv_norm;
+    t.dx[k] *= inv_norm;
+    t.dy[k] *= inv_norm;
+  }
+  t.ok = true;
+  return true;
+}
+
+EpipolarAlignment alignAlongEpipolar(const AlignmentTemplate& t, const ImageView& image, const Vec2& uv0,
+                                     const Vec2& direction, const Mat2& A, double partner_spacing,
                                      const EpipolarAlignmentOptions& options) {
   EpipolarAlignment out;
   out.uv = uv0;
-  const int h = std::clamp(options.half_size, 1, kMaxHalf);
   const double det = A.determinant();
-  if (ref.empty() || image.empty() || !(std::abs(det) > 1e-6) || !A.allFinite()) return out;
+  if (!t.ok || image.empty() || !(std::abs(det) > 1e-6) || !A.allFinite()) return out;
+  const int h = t.half, n = t.samples, padded = t.padded;
+  const double spacing = t.spacing;
   const double max_shift = options.max_shift_spacings * (spacing + partner_spacing);
   const double ex = spacing * h * (std::abs(A(0, 0)) + std::abs(A(0, 1))) + max_shift + 1;
   const double ey = spacing * h * (std::abs(A(1, 0)) + std::abs(A(1, 1))) + max_shift + 1;
-  if (!inside(ref, ref_uv.x(), ref_uv.y(), spacing * (h + 1), spacing * (h + 1)) ||
-      !inside(image, uv0.x(), uv0.y(), ex, ey)) {
-    return out;
-  }
+  if (!inside(image, uv0.x(), uv0.y(), ex, ey)) return out;
 
-  // Template: the reference patch on its grid, one ring more for the gradient.
-  const int side = 2 * h + 3;
-  float t_grid[kMaxSide * kMaxSide];
-  for (int j = 0; j < side; ++j) {
-    const float y = static_cast<float>(ref_uv.y() + spacing * (j - h - 1));
-    for (int i = 0; i < side; ++i) t_grid[j * side + i] = sample(ref, static_cast<float>(ref_uv.x() + spacing * (i - h - 1)), y);
-  }
-  // A shift t along the direction in the partner moves the reference grid by t * w.
+  // A shift s along the direction in the partner moves the reference grid by s * w: the template's derivative
+  // along the shift is its gradient along w (zero mean, as the gradients are).
   const Vec2 w = A.inverse() * direction;
-  const int n = (2 * h + 1) * (2 * h + 1);
-  float tmpl[(2 * kMaxHalf + 1) * (2 * kMaxHalf + 1)], grad[(2 * kMaxHalf + 1) * (2 * kMaxHalf + 1)];
-  float off_x[(2 * kMaxHalf + 1) * (2 * kMaxHalf + 1)], off_y[(2 * kMaxHalf + 1) * (2 * kMaxHalf + 1)];
-  double mean_t = 0;
+  const float wx = static_cast<float>(w.x()), wy = static_cast<float>(w.y());
+  alignas(16) float grad[kMaxPadded], off_x[kMaxPadded], off_y[kMaxPadded];
+  alignas(16) float xs[kMaxPadded], ys[kMaxPadded], values[kMaxPadded];
+  for (int k = 0; k < padded; ++k) grad[k] = t.dx[k] * wx + t.dy[k] * wy;  // padding: zero
+  const Vec2 step_i = A.col(0) * spacing, step_j = A.col(1) * spacing;
   int k = 0;
-  const float gx_scale = static_cast<float>(w.x() / (2 * spacing)), gy_scale = static_cast<float>(w.y() / (2 * spacing));
-  for (int j = 1; j < side - 1; ++j) {
-    for (int i = 1; i < side - 1; ++i, ++k) {
-      const float* c = t_grid + j * side + i;
-      tmpl[k] = c[0];
-      grad[k] = (c[1] - c[-1]) * gx_scale + (c[side] - c[-side]) * gy_scale;
-      const Vec2 q = A * Vec2(spacing * (i - h - 1), spacing * (j - h - 1));
-      off_x[k] = static_cast<float>(q.x());
-      off_y[k] = static_cast<float>(q.y());
-      mean_t += c[0];
+  for (int j = -h; j <= h; ++j) {
+    for (int i = -h; i <= h; ++i, ++k) {
+      off_x[k] = static_cast<float>(step_i.x() * i + step_j.x() * j);
+      off_y[k] = static_cast<float>(step_i.y() * i + step_j.y() * j);
     }
   }
-  mean_t /= n;
-  double var_t = 0, mean_g = 0;
-  for (int m = 0; m < n; ++m) {
-    tmpl[m] -= static_cast<float>(mean_t);
-    var_t += static_cast<double>(tmpl[m]) * tmpl[m];
-    mean_g += grad[m];
-  }
-  mean_g /= n;
-  // Normalised template (zero mean, unit norm) and its derivative; the derivative's mean is removed with the
-  // template's own (the residual is blind to a constant).
-  if (!(var_t > 1e-6)) return out;
-  const double inv_norm_t = 1.0 / std::sqrt(var_t);
-  double hessian = 0;
-  for (int m = 0; m < n; ++m) {
-    tmpl[m] = static_cast<float>(tmpl[m] * inv_norm_t);
-    grad[m] = static_cast<float>((grad[m] - mean_g) * inv_norm_t);
-    hessian += static_cast<double>(grad[m]) * grad[m];
-  }
+  for (; k < padded; ++k) off_x[k] = off_y[k] = 0;  // padding: the centre
+  const Sums gs = dot3(grad, t.value, t.value, padded);
+  const double hessian = gs.s[0], grad_dot_tmpl = gs.s[1];
   if (!(hessian > 1e-12)) return out;
 
-  double t = 0, zncc = 0, residual2 = 0;
-  double previous_t = 0, previous_b = 0;
-  float values[(2 * kMaxHalf + 1) * (2 * kMaxHalf + 1)];
+  double s = 0, zncc = 0, residual2 = 0;
+  double previous_s = 0, previous_b = 0;
   bool converged = false;
   for (int it = 0; it < options.max_iterations; ++it) {
-    const float cx = static_cast<float>(uv0.x() + t * direction.x()), cy = static_cast<float>(uv0.y() + t * direction.y());
-    double sum = 0, sum2 = 0;
-    for (int m = 0; m < n; ++m) {
-      values[m] = sample(image, cx + off_x[m], cy + off_y[m]);
-      sum += values[m];
-      sum2 += static_cast<double>(values[m]) * values[m];
+    const float cx = static_cast<float>(uv0.x() + s * direction.x()), cy = static_cast<float>(uv0.y() + s * direction.y());
+    for (int k = 0; k < padded; ++k) {
+      xs[k] = cx + off_x[k];
+      ys[k] = cy + off_y[k];
     }
-    const double mean = sum / n, var = sum2 - sum * mean;
+    sampleBilinear(image, xs, ys, padded, values);
+    for (int k = n; k < padded; ++k) values[k] = 0;
+    const float mean = static_cast<float>(sum(values, padded) / n);
+    for (int k = 0; k < n; ++k) values[k] -= mean;
+    // With both patches zero mean, and the template and its derivative too: the correlation and the residual's
+    // derivative need only the partner's norm and two dot products.
+    const Sums vs = dot3(values, t.value, grad, padded);
+    const double var = vs.s[0];
     if (!(var > 1e-6)) return out;
     const double inv_norm = 1.0 / std::sqrt(var);
-    double b = 0, cross = 0;
-    for (int m = 0; m < n; ++m) {
-      const double v = (values[m] - mean) * inv_norm;
-      cross += v * tmpl[m];
-      b += grad[m] * (v - tmpl[m]);
-    }
+    const double cross = vs.s[1] * inv_norm;
+    const double b = vs.s[2] * inv_norm - grad_dot_tmpl;
     zncc = cross;
     residual2 = std::max(0.0, 2.0 - 2.0 * cross);  // both unit norm
     // Gauss-Newton's step uses the template's derivative, which the partner's image (other sampling, other
     // blur) only approximates: convergence is linear. From the second step on, the secant of the measured
     // gradient replaces it where it is plausible (superlinear, same fixed point).
     double step = b / hessian;
-    if (it > 0 && t != previous_t) {
-      const double slope = (b - previous_b) / (t - previous_t);
+    if (it > 0 && s != previous_s) {
+      const double slope = (b - previous_b) / (s - previous_s);
       if (slope > 0.2 * hessian && slope < 5 * hessian) step = b / slope;
     }
-    previous_t = t;
+    previous_s = s;
     previous_b = b;
-    t -= step;
-    if (!(std::abs(t) <= max_shift)) {
+    s -= step;
+    if (!(std::abs(s) <= max_shift)) {
       out.status = AlignmentStatus::Disagrees;
       return out;
     }
@@ -131,8 +222,8 @@ EpipolarAlignment alignAlongEpipolar(const ImageView& ref, const Vec2& ref_uv, c
       break;
     }
   }
-  out.uv = uv0 + t * direction;
-  out.shift = t;
+  out.uv = uv0 + s * direction;
+  out.shift = s;
   out.zncc = zncc;
   if (!converged || zncc < options.min_zncc) {
     out.status = AlignmentStatus::Disagrees;
@@ -144,6 +235,18 @@ EpipolarAlignment alignAlongEpipolar(const ImageView& ref, const Vec2& ref_uv, c
   out.sigma_px = std::sqrt(sigma2 + floor * floor);
   out.status = AlignmentStatus::Ok;
   return out;
+}
+
+EpipolarAlignment alignAlongEpipolar(const ImageView& ref, const Vec2& ref_uv, const ImageView& image, const Vec2& uv0,
+                                     const Vec2& direction, const Mat2& A, double spacing, double partner_spacing,
+                                     const EpipolarAlignmentOptions& options) {
+  AlignmentTemplate t;
+  if (!makeAlignmentTemplate(ref, ref_uv, spacing, options, t)) {
+    EpipolarAlignment out;
+    out.uv = uv0;
+    return out;
+  }
+  return alignAlongEpipolar(t, image, uv0, direction, A, partner_spacing, options);
 }
 
 }  // namespace mcslam

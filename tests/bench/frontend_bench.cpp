@@ -9,12 +9,18 @@
 //   FrontEnd5Cam/mcslam             the whole front-end of the 5 overlapping cameras on 2 threads
 //   FrontEnd5Cam/cv_orb             anchor: cv::ORB per camera (2 threads), then the same multi-view matcher with
 //                                   its cameras and pairs on 2 threads (extract_ms: ORB only)
+//   FrontEnd5CamAligned/mcslam      FrontEnd5Cam/mcslam with the subpixel alignment of multi-view partners on
+//                                   (multiview: align_subpixel: true; counters aligned, disagreeing: partners per frame)
+//   FrontEnd5CamAligned/off         anchor: the same front-end and input with the alignment off
+// Every case also reports process_cpu_ms: the CPU of all threads per rig frame (the CPU column is the main thread's
+// alone, and work moved onto the workers leaves it).
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 
 #include <chrono>
+#include <ctime>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -63,15 +69,23 @@ const std::vector<Subset>& subsets() {
   return s;
 }
 
-PipelineConfig configFor(const Rig& rig) {
+PipelineConfig configFor(const Rig& rig, bool align_subpixel = false) {
   PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
   config.feature_threads = kThreads;
+  config.multiview.align_subpixel = align_subpixel;
   return config;
+}
+
+double processCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 // Per-frame counters, averaged over the iterations.
 struct Totals {
-  double keypoints = 0, multiview = 0, mono = 0, extraction_ms = 0, multiview_ms = 0;
+  double keypoints = 0, multiview = 0, mono = 0, extraction_ms = 0, multiview_ms = 0, process_cpu_ms = 0;
+  double aligned = 0, disagreeing = 0;
   int frames = 0;
   void add(const FrameFeatures& f, double ext_ms, double mv_ms) {
     keypoints += f.keypointCount();
@@ -88,13 +102,18 @@ struct Totals {
     state.counters["total"] = (mono + multiview) / n;
     state.counters["extract_ms"] = extraction_ms / n;
     state.counters["match_ms"] = multiview_ms / n;
+    state.counters["process_cpu_ms"] = process_cpu_ms / n;
+    if (aligned + disagreeing > 0) {
+      state.counters["aligned"] = aligned / n;
+      state.counters["disagreeing"] = disagreeing / n;
+    }
   }
 };
 
-void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras) {
+void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras, bool align_subpixel = false) {
   const RenderedSequence& seq = sequence();
   const Rig rig = seq.sim->rig().subset(cameras);
-  FrontEnd front_end(rig, configFor(rig));
+  FrontEnd front_end(rig, configFor(rig, align_subpixel));
   FrameFeatures f(rig.size(), front_end.capacityPerCamera());
   std::vector<ImageView> views(rig.size());
   std::unique_ptr<bool[]> present(new bool[rig.size()]);
@@ -107,7 +126,11 @@ void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras) {
   int k = 0;
   for (auto _ : state) {
     for (int c = 0; c < rig.size(); ++c) views[c] = seq.images[k][cameras[c]].view();
+    const double cpu0 = processCpuMs();
     front_end.compute(view, f);
+    totals.process_cpu_ms += processCpuMs() - cpu0;
+    totals.aligned += front_end.multiViewStats().aligned;
+    totals.disagreeing += front_end.multiViewStats().disagreeing;
     totals.add(f, front_end.timing().extraction_ms, front_end.timing().multiview_ms);
     k = (k + 1) % kFrames;
   }
@@ -115,6 +138,8 @@ void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras) {
 }
 
 void FrontEnd5CamMcslam(benchmark::State& state) { runFrontEnd(state, {0, 1, 2, 3, 4}); }
+void FrontEnd5CamAlignedMcslam(benchmark::State& state) { runFrontEnd(state, {0, 1, 2, 3, 4}, true); }
+void FrontEnd5CamAlignedOff(benchmark::State& state) { runFrontEnd(state, {0, 1, 2, 3, 4}, false); }
 
 // cv::ORB with the same feature count and pyramid, one camera per OpenCV task on 2 threads, then our matcher.
 void FrontEnd5CamCvOrb(benchmark::State& state) {
@@ -140,6 +165,7 @@ void FrontEnd5CamCvOrb(benchmark::State& state) {
   using Clock = std::chrono::steady_clock;
   for (auto _ : state) {
     const auto t0 = Clock::now();
+    const double cpu0 = processCpuMs();
     cv::parallel_for_(cv::Range(0, rig.size()), [&](const cv::Range& r) {
       for (int c = r.start; c < r.end; ++c) {
         const Image& img = seq.images[k][cameras[c]];
@@ -173,6 +199,7 @@ void FrontEnd5CamCvOrb(benchmark::State& state) {
         kThreads);
     matcher.finishFrame(f);
     const auto t2 = Clock::now();
+    totals.process_cpu_ms += processCpuMs() - cpu0;
     totals.add(f, std::chrono::duration<double, std::milli>(t1 - t0).count(),
                std::chrono::duration<double, std::milli>(t2 - t1).count());
     k = (k + 1) % kFrames;
@@ -196,3 +223,13 @@ static const bool kRegistered = [] {
 }();
 BENCHMARK(FrontEnd5CamMcslam)->Name("FrontEnd5Cam/mcslam")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3 * kFrames);
 BENCHMARK(FrontEnd5CamCvOrb)->Name("FrontEnd5Cam/cv_orb")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3 * kFrames);
+BENCHMARK(FrontEnd5CamAlignedMcslam)
+    ->Name("FrontEnd5CamAligned/mcslam")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3 * kFrames);
+BENCHMARK(FrontEnd5CamAlignedOff)
+    ->Name("FrontEnd5CamAligned/off")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3 * kFrames);

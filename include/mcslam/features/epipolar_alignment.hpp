@@ -9,7 +9,7 @@
 // The patch warp between the cameras is the local affine map A of the geometry (rotation, scale and lens
 // distortion about the point, the surface taken normal to the reference ray), given by the caller; only the
 // shift along the epipolar direction is estimated, so the aperture problem of edges cannot move the match off
-// the epipolar curve. No allocation: the patch lives on the stack.
+// the epipolar curve. No allocation: the patches live in the caller's AlignmentTemplate and on the stack.
 #include "mcslam/core/image.hpp"
 #include "mcslam/core/se3.hpp"
 
@@ -45,10 +45,37 @@ struct EpipolarAlignment {
   bool ok() const { return status == AlignmentStatus::Ok; }
 };
 
-// Finds the point of `image` that shows what `ref` shows at ref_uv. uv0: start on the epipolar curve (the
-// partner keypoint projected onto it); direction: unit tangent of the curve there; A: reference pixel offset ->
-// partner pixel offset; spacing: sample spacing in reference pixels (the reference octave's scale);
-// partner_spacing: the partner octave's scale (bounds the shift).
+// The reference side of the alignment, sampled once per track and shared by all its partners (they differ only
+// in the warp): the patch around the reference pixel, zero mean and unit norm, and its derivatives per reference
+// pixel in x and y (normalised alike). Padded to whole groups of 4 samples with zeros.
+struct AlignmentTemplate {
+  static constexpr int kMaxHalf = 6;
+  static constexpr int kMaxSamples = (2 * kMaxHalf + 1) * (2 * kMaxHalf + 1);
+  static constexpr int kMaxPadded = (kMaxSamples + 3) / 4 * 4;
+  bool ok = false;  // false: outside the image or no texture
+  int half = 3;
+  int samples = 0;  // (2 half + 1)^2
+  int padded = 0;   // samples rounded up to a multiple of 4
+  double spacing = 1;
+  Vec2 uv = Vec2::Zero();
+  alignas(16) float value[kMaxPadded];
+  alignas(16) float dx[kMaxPadded];
+  alignas(16) float dy[kMaxPadded];
+};
+
+// Samples the template of `ref` around ref_uv with the given spacing (reference pixels: the reference octave's
+// scale). Returns tmpl.ok.
+bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spacing,
+                           const EpipolarAlignmentOptions& options, AlignmentTemplate& tmpl);
+
+// Finds the point of `image` that shows what the template shows at its centre. uv0: start on the epipolar curve
+// (the partner keypoint projected onto it); direction: unit tangent of the curve there; A: reference pixel
+// offset -> partner pixel offset; partner_spacing: the partner octave's scale (bounds the shift).
+EpipolarAlignment alignAlongEpipolar(const AlignmentTemplate& tmpl, const ImageView& image, const Vec2& uv0,
+                                     const Vec2& direction, const Mat2& A, double partner_spacing,
+                                     const EpipolarAlignmentOptions& options);
+
+// Both steps for one partner: spacing is the reference octave's scale.
 EpipolarAlignment alignAlongEpipolar(const ImageView& ref, const Vec2& ref_uv, const ImageView& image, const Vec2& uv0,
                                      const Vec2& direction, const Mat2& A, double spacing, double partner_spacing,
                                      const EpipolarAlignmentOptions& options);

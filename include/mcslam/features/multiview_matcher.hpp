@@ -94,8 +94,13 @@ class MultiViewMatcher {
   void gatherMatches();
   void mergeTracks(FrameFeatures& f);
   void finishTrack(FrameFeatures& f, int first, int size);
+  struct ReferencePatch {
+    AlignmentTemplate patch;
+    Eigen::Matrix<double, 3, 2> J_pinv;  // reference pixel offset -> bearing offset normal to the ray
+  };
   int alignToReference(FrameFeatures& f, int first, int size);
-  AlignmentStatus alignPartner(const FrameFeatures& f, int first, int s);
+  AlignmentStatus alignPartner(const FrameFeatures& f, int first, int s, const ReferencePatch& ref);
+  void prefetchPatches(const FrameFeatures& f, int m);
   void swapMembers(FrameFeatures& f, int first, int a, int b);
   bool bearingOf(int cam, const Vec2& uv, Vec3& bearing) const;
   int find(int node);
@@ -168,6 +173,7 @@ class MultiViewMatcher {
     bool aligned;
   };
   std::vector<Member> members_obs_;
+  ReferencePatch reference_;  // the current track's
   const ImageView* images_ = nullptr;  // the current frame's, during compute()
 };
 
