@@ -59,6 +59,22 @@ void FeatureWorkers::extract(const ImageView* images, const bool* present, Featu
   work_done_.wait(lock, [this] { return remaining_ == 0; });
 }
 
+void FeatureWorkers::runTasks(WorkerTasks& tasks) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const int count = tasks.taskCount();
+  if (count <= 0) return;
+  batch_ = &tasks;
+  batch_next_ = 0;
+  batch_count_ = count;
+  next_camera_ = cameras();  // no camera to extract, no follow-up task
+  untaken_tasks_ = 0;
+  remaining_ = count;
+  ++frame_;
+  work_ready_.notify_all();
+  work_done_.wait(lock, [this] { return remaining_ == 0; });
+  batch_ = nullptr;
+}
+
 void FeatureWorkers::processCamera(int camera, OrbExtractor& extractor) {
   FeatureSet& out = out_[camera];
   OrbStatus result = OrbStatus::kOk;
@@ -101,6 +117,11 @@ void FeatureWorkers::run(int thread) {
         }
         lock.unlock();
         follow_up_->runTask(task, thread);
+        lock.lock();
+      } else if (batch_ != nullptr && batch_next_ < batch_count_) {
+        const int task = batch_next_++;
+        lock.unlock();
+        batch_->runTask(task, thread);
         lock.lock();
       } else {
         break;

@@ -123,6 +123,11 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
   distance_count_.resize(258);
   scratch_obs_.resize(n);
   members_obs_.resize(n);
+  track_first_.resize(parent_.size());
+  track_size_.resize(parent_.size());
+  track_aligned_.resize(parent_.size());
+  track_disagreeing_.resize(parent_.size());
+  aligned_obs_.resize(parent_.size());
 }
 
 void MultiViewMatcher::compute(FrameFeatures& f, const ImageView* images) {
@@ -152,10 +157,16 @@ void MultiViewMatcher::matchPair(const FrameFeatures& f, int pair, int thread) {
 }
 
 void MultiViewMatcher::finishFrame(FrameFeatures& f) {
+  mergeFrame(f);
+  for (int task = 0; task < alignTaskCount(); ++task) alignTracks(f, task);
+  emitTracks(f);
+}
+
+void MultiViewMatcher::mergeFrame(FrameFeatures& f) {
   gatherMatches();
   stats_.pair_matches = match_count_;
   mergeTracks(f);
-  images_ = nullptr;
+  aligned_frame_ = images_ != nullptr;
 }
 
 // The pairs' slots moved to the front, in pair order (each slot starts at or after its destination).
@@ -494,41 +505,39 @@ void MultiViewMatcher::mergeTracks(FrameFeatures& f) {
       ++placed;
     }
   }
+  track_count_ = 0;
   for (int m = 0; m < placed;) {
     const int size = component_size_[find(members_[m])];
-    if (images_ != nullptr && m + size < placed) prefetchPatches(f, m + size);
-    const int first = f.mv_ref_count;
-    for (int s = 0; s < size; ++s) {
-      const int node = members_[m + s];
-      f.mv_refs[first + s] = KeypointRef{static_cast<int16_t>(node / capacity_), node % capacity_};
-    }
-    finishTrack(f, first, size);
+    track_first_[track_count_] = m;
+    track_size_[track_count_] = size;
+    ++track_count_;
     m += size;
   }
 }
 
-// The alignment reads a patch around every keypoint of a track in images that the workers, on other cores,
-// extracted: its loads miss the cache and dominated its time (each track's first patch reads waited for memory).
-// The next track's patches are requested while this one is aligned.
-void MultiViewMatcher::prefetchPatches(const FrameFeatures& f, int m) {
-  const int size = component_size_[find(members_[m])];
-  const int h = std::clamp(options_.alignment.half_size, 1, AlignmentTemplate::kMaxHalf);
-  for (int s = 0; s < size; ++s) {
-    const int node = members_[m + s];
-    const int cam = node / capacity_;
-    const ImageView& im = images_[cam];
-    if (im.empty()) continue;
-    const Keypoint& kp = f.sets[cam].keypoints[node % capacity_];
-    // The patch, its ring of derivatives and the shift bound, at this keypoint's scale (the warp between the
-    // front cameras is close to a rotation at equal scale; a line missed here is only a later miss).
-    const int r = static_cast<int>((h + 2) * sigma_[std::clamp<int>(kp.octave, 0, kMaxOctaves - 1)]) + 2;
-    const int x0 = std::max(0, static_cast<int>(kp.x) - r), x1 = std::min(im.width - 1, static_cast<int>(kp.x) + r);
-    const int y0 = std::max(0, static_cast<int>(kp.y) - r), y1 = std::min(im.height - 1, static_cast<int>(kp.y) + r);
-    for (int y = y0; y <= y1; ++y) {
-      const uint8_t* row = im.row(y);
-      for (int x = x0 & ~63; x <= x1; x += 64) __builtin_prefetch(row + std::max(x, x0));
+// The tracks in member order, each into f.mv_refs from its current end (a dropped track leaves no trace).
+void MultiViewMatcher::emitTracks(FrameFeatures& f) {
+  for (int t = 0; t < track_count_; ++t) {
+    const int first = f.mv_ref_count, size = track_size_[t];
+    const int32_t* nodes = members_.data() + track_first_[t];
+    for (int s = 0; s < size; ++s) {
+      f.mv_refs[first + s] = KeypointRef{static_cast<int16_t>(nodes[s] / capacity_), nodes[s] % capacity_};
+      if (aligned_frame_) {
+        members_obs_[s] = aligned_obs_[track_first_[t] + s];
+      } else {
+        const KeypointRef& r = f.mv_refs[first + s];
+        const Keypoint& kp = f.sets[r.cam].keypoints[r.index];
+        members_obs_[s] = Member{Vec2(kp.x, kp.y), f.bearings[r.cam][r.index], sigma_[kp.octave], false};
+      }
     }
+    if (aligned_frame_) {
+      stats_.aligned += track_aligned_[t];
+      stats_.disagreeing += track_disagreeing_[t];
+    }
+    finishTrack(f, first, size);
   }
+  images_ = nullptr;
+  aligned_frame_ = false;
 }
 
 void MultiViewMatcher::swapMembers(FrameFeatures& f, int first, int a, int b) {
@@ -536,115 +545,8 @@ void MultiViewMatcher::swapMembers(FrameFeatures& f, int first, int a, int b) {
   std::swap(members_obs_[a], members_obs_[b]);
 }
 
-// The partner's keypoint aligned to what the reference keypoint (member 0) shows: the epipolar curve of the
-// reference pixel in the partner camera is Y(rho) = rho * b + m in that camera's frame (rho: inverse range
-// along the reference ray; rho = 0 is the point at infinity), the start is the partner keypoint projected onto
-// it, and the patch warp is the derivative of the reference pixel -> partner pixel map there. ref: the track's
-// reference patch and the pseudo-inverse of its projection's Jacobian at the unit bearing.
-AlignmentStatus MultiViewMatcher::alignPartner(const FrameFeatures& f, int first, int s, const ReferencePatch& ref) {
-  const KeypointRef& r = f.mv_refs[first];
-  const KeypointRef& p = f.mv_refs[first + s];
-  const ImageView& image = images_[p.cam];
-  if (image.empty()) return AlignmentStatus::NotRefinable;
-  const SE3& T_b_r = rig_.T_b_c(r.cam);
-  const SE3& T_b_p = rig_.T_b_c(p.cam);
-  const CameraModel& model_p = rig_.model(p.cam);
-  const Vec3& bearing_r = f.bearings[r.cam][r.index];
-  const Mat3 R_p_b = T_b_p.R.transpose();
-  const Vec3 b = R_p_b * (T_b_r.t - T_b_p.t);
-  const Vec3 m = R_p_b * (T_b_r.R * bearing_r);
-
-  // Start: the inverse range where the two rays pass closest, then Gauss-Newton onto the partner keypoint.
-  const Keypoint& kp = f.sets[p.cam].keypoints[p.index];
-  const Vec2 uv_kp(kp.x, kp.y);
-  const Vec3& bearing_p = f.bearings[p.cam][p.index];
-  const double cos_rays = m.dot(bearing_p);
-  const Vec3 w0 = -b;  // partner centre minus reference centre, partner frame
-  double rho = 0;
-  if (1 - cos_rays * cos_rays > 1e-12) {
-    const double range = (-w0.dot(m) + cos_rays * w0.dot(bearing_p)) / (1 - cos_rays * cos_rays);
-    if (range > options_.triangulation.min_depth) rho = 1.0 / range;
-  }
-  // Within half a pixel of the keypoint the curve is straight to far below the alignment's precision: the
-  // last step is taken on the tangent rather than projected again (each projection through the lens model is a
-  // sizeable share of a partner's cost).
-  Vec2 uv;
-  Mat23 J;
-  Vec2 g = Vec2::Zero();
-  for (int it = 0;; ++it) {
-    if (!model_p.project(rho * b + m, uv, &J)) return AlignmentStatus::NotRefinable;
-    g = J * b;
-    const double gg = g.squaredNorm();
-    if (!(gg > 1e-12)) return AlignmentStatus::NotRefinable;  // the reference ray runs along the baseline
-    const double step = std::max(-rho, g.dot(uv_kp - uv) / gg);
-    if (step * step * gg < 0.25 || it == 2) {
-      rho += step;
-      uv += step * g;
-      break;
-    }
-    rho += step;
-  }
-  // Patch warp: a reference pixel offset moves the point normal to the reference ray (pseudo-inverse of the
-  // reference projection's Jacobian at the unit bearing; the range cancels against the partner's Jacobian at Y).
-  const Mat2 A = J * (R_p_b * T_b_r.R) * ref.J_pinv;
-  const double g_norm = g.norm();
-  const EpipolarAlignment a = alignAlongEpipolar(ref.patch, image, uv, g / g_norm, A, sigma_[kp.octave], options_.alignment);
-  if (a.ok()) {
-    // The aligned point lies on the curve: its bearing is the curve's at the shifted inverse range.
-    Member& member = members_obs_[s];
-    member.uv = a.uv;
-    member.bearing = (m + (rho + a.shift / g_norm) * b).normalized();
-    member.sigma_px = a.sigma_px;
-    member.aligned = true;
-  }
-  return a.status;
-}
-
-// Aligns every partner to the reference (the finest keypoint, moved to member 0); partners whose patches
-// disagree leave the track. Returns the new size. An aligned track's rays all pass through the scene point of
-// the reference pixel: that pixel defines the point, so the reference keeps only the alignment's floor sigma.
-int MultiViewMatcher::alignToReference(FrameFeatures& f, int first, int size) {
-  int ref = 0;
-  for (int s = 1; s < size; ++s) {
-    const KeypointRef& a = f.mv_refs[first + s];
-    const KeypointRef& b = f.mv_refs[first + ref];
-    if (f.sets[a.cam].keypoints[a.index].octave < f.sets[b.cam].keypoints[b.index].octave) ref = s;
-  }
-  swapMembers(f, first, 0, ref);
-  // The reference side, once for all partners.
-  const KeypointRef& r = f.mv_refs[first];
-  const Keypoint& kr = f.sets[r.cam].keypoints[r.index];
-  Vec2 uv_r;
-  Mat23 J_r;
-  if (!rig_.model(r.cam).project(f.bearings[r.cam][r.index], uv_r, &J_r)) return size;
-  reference_.J_pinv = J_r.transpose() * (J_r * J_r.transpose()).inverse();
-  if (!makeAlignmentTemplate(images_[r.cam], Vec2(kr.x, kr.y), sigma_[kr.octave], options_.alignment, reference_.patch)) {
-    return size;  // every partner would be NotRefinable
-  }
-  bool any = false;
-  for (int s = 1; s < size;) {
-    const AlignmentStatus status = alignPartner(f, first, s, reference_);
-    if (status == AlignmentStatus::Disagrees) {
-      ++stats_.disagreeing;
-      swapMembers(f, first, s, size - 1);
-      --size;
-      continue;
-    }
-    any = any || status == AlignmentStatus::Ok;
-    stats_.aligned += status == AlignmentStatus::Ok ? 1 : 0;
-    ++s;
-  }
-  if (any) members_obs_[0].sigma_px = options_.alignment.sigma_floor_spacings * sigma_[kr.octave];
-  return size;
-}
-
+// The track's members are in f.mv_refs[first, first + size) and their observations in members_obs_.
 void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
-  for (int s = 0; s < size; ++s) {
-    const KeypointRef& r = f.mv_refs[first + s];
-    const Keypoint& kp = f.sets[r.cam].keypoints[r.index];
-    members_obs_[s] = Member{Vec2(kp.x, kp.y), f.bearings[r.cam][r.index], sigma_[kp.octave], false};
-  }
-  if (images_ != nullptr) size = alignToReference(f, first, size);
   auto fillObservations = [&](int n) {
     for (int s = 0; s < n; ++s) {
       const KeypointRef& r = f.mv_refs[first + s];

@@ -47,7 +47,10 @@ void FrontEnd::compute(const RigFrameView& frame, FrameFeatures& out) {
   matching_tasks_.setFrame(&out);
   workers_.extract(images_.data(), present_.get(), out.sets.data());  // an absent camera gets no keypoints
   const auto t1 = Clock::now();
-  matcher_.finishFrame(out);
+  matcher_.mergeFrame(out);
+  alignment_tasks_.setFrame(&out);
+  workers_.runTasks(alignment_tasks_);  // nothing when the alignment is off
+  matcher_.emitTracks(out);
   const auto t2 = Clock::now();
   timing_.extraction_ms = msBetween(t0, t1);
   timing_.multiview_ms = msBetween(t1, t2);

@@ -1,9 +1,10 @@
 // The front-end spreads the multi-view matcher's cameras and pairs over its ORB workers: its features must be
 // exactly those of the sequential path (each camera extracted alone, then MultiViewMatcher::compute()), for
-// any thread count, with a camera absent too.
+// any thread count, with a camera absent too, and with the subpixel alignment of the partners on.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <utility>
 
 #include "mcslam/pipeline/front_end.hpp"
 #include "mcslam/pipeline/pipeline_config.hpp"
@@ -46,7 +47,8 @@ TEST(FrontEnd, MatchingOnTheWorkersGivesTheSequentialFeatures) {
   const Rig rig = sim.rig().subset(front);
   const test::RenderedFrame rendered = test::renderFrame(sim, sim.frameCount() / 3, front);
 
-  for (const bool camera_absent : {false, true}) {
+  for (const auto& [camera_absent, align] : {std::pair{false, false}, std::pair{true, false}, std::pair{false, true},
+                                            std::pair{true, true}}) {
     RigFrameView view = rendered.view();
     view.cameras = rig.size();
     std::unique_ptr<bool[]> present(new bool[rig.size()]);
@@ -54,6 +56,8 @@ TEST(FrontEnd, MatchingOnTheWorkersGivesTheSequentialFeatures) {
     view.present = present.get();
 
     PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
+    // The subpixel alignment runs on the workers too, in tasks of consecutive tracks.
+    config.multiview.align_subpixel = align;
     // The sequential reference: one extractor per camera, then the matcher on one thread.
     FrameFeatures expected(rig.size(), config.orb.max_features);
     OverlapMap overlap(rig, config.overlap);
@@ -67,6 +71,9 @@ TEST(FrontEnd, MatchingOnTheWorkersGivesTheSequentialFeatures) {
     }
     matcher.compute(expected, view.images);
     ASSERT_GT(expected.mv_count, 200);
+    if (align) {
+      ASSERT_GT(matcher.stats().aligned, 500);
+    }
 
     for (const int threads : {1, 2, 3}) {
       config.feature_threads = threads;
@@ -74,8 +81,11 @@ TEST(FrontEnd, MatchingOnTheWorkersGivesTheSequentialFeatures) {
       FrameFeatures f(rig.size(), front_end.capacityPerCamera());
       for (int repeat = 0; repeat < 3; ++repeat) {  // reused storage, other interleavings
         front_end.compute(view, f);
-        SCOPED_TRACE(testing::Message() << "threads " << threads << ", camera absent " << camera_absent);
+        SCOPED_TRACE(testing::Message() << "threads " << threads << ", camera absent " << camera_absent << ", aligned "
+                                        << align);
         expectSameFeatures(expected, f);
+        EXPECT_EQ(front_end.multiViewStats().aligned, matcher.stats().aligned);
+        EXPECT_EQ(front_end.multiViewStats().disagreeing, matcher.stats().disagreeing);
       }
     }
   }

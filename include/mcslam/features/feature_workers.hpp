@@ -38,6 +38,15 @@ class ExtractionFollowUp {
   virtual void runTask(int task, int thread) = 0;
 };
 
+// Independent tasks run on the workers outside extract() (FeatureWorkers::runTasks()).
+class WorkerTasks {
+ public:
+  virtual ~WorkerTasks() = default;
+  virtual int taskCount() const = 0;
+  // `thread` is the worker's index, so that concurrent tasks may use distinct scratch.
+  virtual void runTask(int task, int thread) = 0;
+};
+
 class FeatureWorkers {
  public:
   // max_sizes: the largest image of each camera. threads <= 0: min(cameras, hardware_concurrency()).
@@ -50,6 +59,10 @@ class FeatureWorkers {
   // images, present and out have one entry per camera; out[c] needs capacity >= max_features.
   // An absent camera gets zero features. status (optional, one per camera) receives each result.
   void extract(const ImageView* images, const bool* present, FeatureSet* out, OrbStatus* status = nullptr);
+
+  // Runs every task of `tasks` on the worker threads, each once, and returns when all are done (a barrier like
+  // extract()). Allocates nothing.
+  void runTasks(WorkerTasks& tasks);
 
   // Runs `follow_up` (nullptr: none) within every following extract(); call between frames. Allocates its
   // bookkeeping here, so a frame still allocates nothing.
@@ -81,6 +94,8 @@ class FeatureWorkers {
   int untaken_tasks_ = 0;          // guarded by mutex_
   std::vector<uint8_t> done_;      // per camera, this frame (guarded by mutex_)
   std::vector<uint8_t> taken_;     // per task, this frame (guarded by mutex_)
+  WorkerTasks* batch_ = nullptr;   // runTasks()'s (guarded by mutex_)
+  int batch_next_ = 0, batch_count_ = 0;
 
   // The current frame's arguments, valid while remaining_ > 0.
   const ImageView* images_ = nullptr;

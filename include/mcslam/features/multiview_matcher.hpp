@@ -36,8 +36,8 @@ struct MultiViewOptions {
   int min_metric_views = 0;
   // Subpixel alignment of every partner keypoint to the track's reference keypoint (the finest octave) along
   // the epipolar curve, when the images are given to compute(); partners whose patches disagree leave the track.
-  // Off by default: it costs about 9 ms of main-thread CPU per 5-camera rig frame (patch reads that miss the
-  // cache across five images; docs/benchmarks/frontend.md), above the front-end's budget.
+  // Off by default: it costs about 5 ms of CPU per 5-camera rig frame (on the front-end's workers; main-thread
+  // CPU about none; docs/benchmarks/frontend.md).
   bool align_subpixel = false;
   EpipolarAlignmentOptions alignment;
 
@@ -79,6 +79,13 @@ class MultiViewMatcher {
   std::pair<int, int> pairCameras(int pair) const { return overlap_.overlappingPairs()[static_cast<size_t>(pair)]; }
   void matchPair(const FrameFeatures& frame, int pair, int thread);
   void finishFrame(FrameFeatures& frame);
+  // finishFrame() in steps, for callers that run the subpixel alignment on their threads: mergeFrame();
+  // alignTracks() for every task below alignTaskCount() (0 when the alignment is off or has no images), in any
+  // order and on any threads, each task once; emitTracks(). The result is finishFrame()'s, whatever the threads.
+  void mergeFrame(FrameFeatures& frame);
+  int alignTaskCount() const;
+  void alignTracks(const FrameFeatures& frame, int task);
+  void emitTracks(FrameFeatures& frame);
 
  private:
   struct Match {
@@ -94,13 +101,21 @@ class MultiViewMatcher {
   void gatherMatches();
   void mergeTracks(FrameFeatures& f);
   void finishTrack(FrameFeatures& f, int first, int size);
+  // The current track's observations (parallel to its mv_refs): position, bearing and sigma after alignment.
+  struct Member {
+    Vec2 uv;
+    Vec3 bearing;
+    double sigma_px;
+    bool aligned;
+  };
   struct ReferencePatch {
     AlignmentTemplate patch;
     Eigen::Matrix<double, 3, 2> J_pinv;  // reference pixel offset -> bearing offset normal to the ray
   };
-  int alignToReference(FrameFeatures& f, int first, int size);
-  AlignmentStatus alignPartner(const FrameFeatures& f, int first, int s, const ReferencePatch& ref);
-  void prefetchPatches(const FrameFeatures& f, int m);
+  void alignTrack(const FrameFeatures& f, int track);
+  AlignmentStatus alignPartner(const FrameFeatures& f, int ref_node, int node, const ReferencePatch& ref,
+                               Member& out) const;
+  void prefetchPatches(const FrameFeatures& f, int track) const;
   void swapMembers(FrameFeatures& f, int first, int a, int b);
   bool bearingOf(int cam, const Vec2& uv, Vec3& bearing) const;
   int find(int node);
@@ -165,15 +180,17 @@ class MultiViewMatcher {
   std::vector<int32_t> component_size_;
   std::vector<int32_t> members_;         // nodes grouped by component
   std::vector<TriangulationObservation> scratch_obs_;
-  // The current track's observations (parallel to its mv_refs): position, bearing and sigma after alignment.
-  struct Member {
-    Vec2 uv;
-    Vec3 bearing;
-    double sigma_px;
-    bool aligned;
-  };
   std::vector<Member> members_obs_;
-  ReferencePatch reference_;  // the current track's
+  // The tracks of the frame (mergeFrame()): members_[first, first + size) each, the reference first and the
+  // partners that disagree moved past the size once aligned; per track the alignment's counts, per member of
+  // members_ its observation after the alignment.
+  int track_count_ = 0;
+  std::vector<int32_t> track_first_;
+  std::vector<int32_t> track_size_;
+  std::vector<int16_t> track_aligned_;
+  std::vector<int16_t> track_disagreeing_;
+  std::vector<Member> aligned_obs_;
+  bool aligned_frame_ = false;  // this frame's tracks are aligned (alignment on, images given)
   const ImageView* images_ = nullptr;  // the current frame's, during compute()
 };
 

@@ -13,7 +13,7 @@ namespace mcslam {
 
 struct FrontEndTiming {
   double extraction_ms = 0;  // ORB on the workers, with the pairwise multi-view matching that fills their idle time
-  double multiview_ms = 0;   // the pairwise matches merged into tracks and triangulated
+  double multiview_ms = 0;   // the pairwise matches merged into tracks (aligned on the workers) and triangulated
 };
 
 class FrontEnd {
@@ -48,12 +48,26 @@ class FrontEnd {
     FrameFeatures* frame_ = nullptr;
   };
 
+  // The subpixel alignment of the frame's tracks (opt-in), as tasks of the ORB workers once the tracks are merged.
+  class AlignmentTasks : public WorkerTasks {
+   public:
+    explicit AlignmentTasks(MultiViewMatcher& matcher) : matcher_(matcher) {}
+    void setFrame(const FrameFeatures* frame) { frame_ = frame; }
+    int taskCount() const override { return matcher_.alignTaskCount(); }
+    void runTask(int task, int /*thread*/) override { matcher_.alignTracks(*frame_, task); }
+
+   private:
+    MultiViewMatcher& matcher_;
+    const FrameFeatures* frame_ = nullptr;
+  };
+
   const Rig& rig_;
   int capacity_;
   OverlapMap overlap_;
   FeatureWorkers workers_;
   MultiViewMatcher matcher_;
   MatchingTasks matching_tasks_{matcher_};
+  AlignmentTasks alignment_tasks_{matcher_};
   std::vector<ImageView> images_;
   std::unique_ptr<bool[]> present_;
   FrontEndTiming timing_;

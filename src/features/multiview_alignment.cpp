@@ -1,0 +1,166 @@
+// MultiViewMatcher's subpixel alignment of the partners of every track to its reference keypoint (the opt-in
+// multiview: align_subpixel). It runs between mergeFrame() and emitTracks(), in tasks of consecutive tracks
+// that the caller may spread over threads: a track's alignment reads only the frame (keypoints, bearings,
+// images) and writes only its own members, counters and observations, so the result does not depend on which
+// thread aligned which task, nor in which order.
+#include <algorithm>
+#include <cmath>
+
+#include "mcslam/features/multiview_matcher.hpp"
+
+namespace mcslam {
+
+namespace {
+// Tracks per task: a few hundred microseconds of work, so that two threads end close together.
+constexpr int kTracksPerAlignTask = 48;
+}  // namespace
+
+int MultiViewMatcher::alignTaskCount() const {
+  return aligned_frame_ ? (track_count_ + kTracksPerAlignTask - 1) / kTracksPerAlignTask : 0;
+}
+
+void MultiViewMatcher::alignTracks(const FrameFeatures& f, int task) {
+  const int begin = task * kTracksPerAlignTask, end = std::min(track_count_, begin + kTracksPerAlignTask);
+  for (int t = begin; t < end; ++t) {
+    if (t + 1 < track_count_) prefetchPatches(f, t + 1);
+    alignTrack(f, t);
+  }
+}
+
+// The alignment reads a patch around every keypoint of a track in images that the workers, on other cores,
+// extracted: its loads miss the cache and dominated its time (each track's first patch reads waited for memory).
+// The next track's patches are requested while this one is aligned.
+void MultiViewMatcher::prefetchPatches(const FrameFeatures& f, int t) const {
+  const int32_t* nodes = members_.data() + track_first_[t];
+  const int h = std::clamp(options_.alignment.half_size, 1, AlignmentTemplate::kMaxHalf);
+  for (int s = 0; s < track_size_[t]; ++s) {
+    const int cam = nodes[s] / capacity_;
+    const ImageView& im = images_[cam];
+    if (im.empty()) continue;
+    const Keypoint& kp = f.sets[cam].keypoints[nodes[s] % capacity_];
+    // The patch, its ring of derivatives and the shift bound, at this keypoint's scale (the warp between the
+    // front cameras is close to a rotation at equal scale; a line missed here is only a later miss).
+    const int r = static_cast<int>((h + 2) * sigma_[std::clamp<int>(kp.octave, 0, kMaxOctaves - 1)]) + 2;
+    const int x0 = std::max(0, static_cast<int>(kp.x) - r), x1 = std::min(im.width - 1, static_cast<int>(kp.x) + r);
+    const int y0 = std::max(0, static_cast<int>(kp.y) - r), y1 = std::min(im.height - 1, static_cast<int>(kp.y) + r);
+    for (int y = y0; y <= y1; ++y) {
+      const uint8_t* row = im.row(y);
+      for (int x = x0 & ~63; x <= x1; x += 64) __builtin_prefetch(row + std::max(x, x0));
+    }
+  }
+}
+
+// Aligns every partner of track t to its reference (the finest keypoint, moved to member 0); partners whose
+// patches disagree move past the track's new size and stay mono features. An aligned track's rays all pass
+// through the scene point of the reference pixel: that pixel defines the point, so the reference keeps only
+// the alignment's floor sigma.
+void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
+  int32_t* nodes = members_.data() + track_first_[t];
+  Member* obs = aligned_obs_.data() + track_first_[t];
+  int size = track_size_[t];
+  auto keypointOf = [&](int s) -> const Keypoint& { return f.sets[nodes[s] / capacity_].keypoints[nodes[s] % capacity_]; };
+  int ref = 0;
+  for (int s = 0; s < size; ++s) {
+    const Keypoint& kp = keypointOf(s);
+    obs[s] = Member{Vec2(kp.x, kp.y), f.bearings[nodes[s] / capacity_][nodes[s] % capacity_], sigma_[kp.octave], false};
+    if (kp.octave < keypointOf(ref).octave) ref = s;
+  }
+  auto swap = [&](int a, int b) {
+    std::swap(nodes[a], nodes[b]);
+    std::swap(obs[a], obs[b]);
+  };
+  swap(0, ref);
+  track_aligned_[t] = 0;
+  track_disagreeing_[t] = 0;
+  // The reference side, once for all partners.
+  const int ref_cam = nodes[0] / capacity_;
+  const Keypoint& kr = keypointOf(0);
+  ReferencePatch reference;
+  Vec2 uv_r;
+  Mat23 J_r;
+  if (!rig_.model(ref_cam).project(obs[0].bearing, uv_r, &J_r)) return;
+  reference.J_pinv = J_r.transpose() * (J_r * J_r.transpose()).inverse();
+  if (!makeAlignmentTemplate(images_[ref_cam], Vec2(kr.x, kr.y), sigma_[kr.octave], options_.alignment, reference.patch)) {
+    return;  // every partner would be NotRefinable
+  }
+  bool any = false;
+  for (int s = 1; s < size;) {
+    const AlignmentStatus status = alignPartner(f, nodes[0], nodes[s], reference, obs[s]);
+    if (status == AlignmentStatus::Disagrees) {
+      ++track_disagreeing_[t];
+      swap(s, size - 1);
+      --size;
+      continue;
+    }
+    any = any || status == AlignmentStatus::Ok;
+    track_aligned_[t] += status == AlignmentStatus::Ok ? 1 : 0;
+    ++s;
+  }
+  if (any) obs[0].sigma_px = options_.alignment.sigma_floor_spacings * sigma_[kr.octave];
+  track_size_[t] = size;
+}
+
+// The partner's keypoint aligned to what the reference keypoint shows: the epipolar curve of the reference
+// pixel in the partner camera is Y(rho) = rho * b + m in that camera's frame (rho: inverse range along the
+// reference ray; rho = 0 is the point at infinity), the start is the partner keypoint projected onto it, and
+// the patch warp is the derivative of the reference pixel -> partner pixel map there. ref: the track's
+// reference patch and the pseudo-inverse of its projection's Jacobian at the unit bearing. Fills `out` when Ok.
+AlignmentStatus MultiViewMatcher::alignPartner(const FrameFeatures& f, int ref_node, int node, const ReferencePatch& ref,
+                                               Member& out) const {
+  const int r_cam = ref_node / capacity_, r_index = ref_node % capacity_;
+  const int p_cam = node / capacity_, p_index = node % capacity_;
+  const ImageView& image = images_[p_cam];
+  if (image.empty()) return AlignmentStatus::NotRefinable;
+  const SE3& T_b_r = rig_.T_b_c(r_cam);
+  const SE3& T_b_p = rig_.T_b_c(p_cam);
+  const CameraModel& model_p = rig_.model(p_cam);
+  const Vec3& bearing_r = f.bearings[r_cam][r_index];
+  const Mat3 R_p_b = T_b_p.R.transpose();
+  const Vec3 b = R_p_b * (T_b_r.t - T_b_p.t);
+  const Vec3 m = R_p_b * (T_b_r.R * bearing_r);
+
+  // Start: the inverse range where the two rays pass closest, then Gauss-Newton onto the partner keypoint.
+  const Keypoint& kp = f.sets[p_cam].keypoints[p_index];
+  const Vec2 uv_kp(kp.x, kp.y);
+  const Vec3& bearing_p = f.bearings[p_cam][p_index];
+  const double cos_rays = m.dot(bearing_p);
+  const Vec3 w0 = -b;  // partner centre minus reference centre, partner frame
+  double rho = 0;
+  if (1 - cos_rays * cos_rays > 1e-12) {
+    const double range = (-w0.dot(m) + cos_rays * w0.dot(bearing_p)) / (1 - cos_rays * cos_rays);
+    if (range > options_.triangulation.min_depth) rho = 1.0 / range;
+  }
+  // Within half a pixel of the keypoint the curve is straight to far below the alignment's precision: the
+  // last step is taken on the tangent rather than projected again (each projection through the lens model is a
+  // sizeable share of a partner's cost).
+  Vec2 uv;
+  Mat23 J;
+  Vec2 g = Vec2::Zero();
+  for (int it = 0;; ++it) {
+    if (!model_p.project(rho * b + m, uv, &J)) return AlignmentStatus::NotRefinable;
+    g = J * b;
+    const double gg = g.squaredNorm();
+    if (!(gg > 1e-12)) return AlignmentStatus::NotRefinable;  // the reference ray runs along the baseline
+    const double step = std::max(-rho, g.dot(uv_kp - uv) / gg);
+    rho += step;
+    if (step * step * gg < 0.25 || it == 2) {
+      uv += step * g;
+      break;
+    }
+  }
+  // Patch warp: a reference pixel offset moves the point normal to the reference ray (pseudo-inverse of the
+  // reference projection's Jacobian at the unit bearing; the range cancels against the partner's Jacobian at Y).
+  const Mat2 A = J * (R_p_b * T_b_r.R) * ref.J_pinv;
+  const double g_norm = g.norm();
+  const EpipolarAlignment a = alignAlongEpipolar(ref.patch, image, uv, g / g_norm, A, sigma_[kp.octave], options_.alignment);
+  if (a.ok()) {
+    // The aligned point lies on the curve: its bearing is the curve's at the shifted inverse range.
+    out.uv = a.uv;
+    out.bearing = (m + (rho + a.shift / g_norm) * b).normalized();
+    out.sigma_px = a.sigma_px;
+    out.aligned = true;
+  }
+  return a.status;
+}
+
+}  // namespace mcslam
