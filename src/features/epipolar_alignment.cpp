@@ -141,8 +141,33 @@ bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spac
     t.dx[k] *= inv_norm;
     t.dy[k] *= inv_norm;
   }
+  // The dominant gradient's direction: the main axis of the structure tensor.
+  double sxx = 0, sxy = 0, syy = 0;
+  for (k = 0; k < t.samples; ++k) {
+    sxx += static_cast<double>(t.dx[k]) * t.dx[k];
+    sxy += static_cast<double>(t.dx[k]) * t.dy[k];
+    syy += static_cast<double>(t.dy[k]) * t.dy[k];
+  }
+  const double axis = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  const double ax = std::cos(axis), ay = std::sin(axis);
+  t.axis = Vec2(ax, ay);
   t.ok = true;
   return true;
+}
+
+Vec2 informationCentroid(const AlignmentTemplate& t) {
+  if (!t.ok) return Vec2::Zero();
+  double weight = 0, along = 0;
+  int k = 0;
+  for (int j = -t.half; j <= t.half; ++j) {
+    for (int i = -t.half; i <= t.half; ++i, ++k) {
+      const double g = t.dx[k] * t.axis.x() + t.dy[k] * t.axis.y();
+      weight += g * g;
+      along += g * g * (t.axis.x() * i + t.axis.y() * j);
+    }
+  }
+  if (!(weight > 0)) return Vec2::Zero();
+  return t.axis * (t.spacing * along / weight);
 }
 
 EpipolarAlignment alignAlongEpipolar(const AlignmentTemplate& t, const ImageView& image, const Vec2& uv0,

@@ -76,13 +76,30 @@ void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
   const int ref_cam = nodes[0] / capacity_;
   const Keypoint& kr = keypointOf(0);
   ReferencePatch reference;
-  Vec2 uv_r;
-  Mat23 J_r;
-  if (!rig_.model(ref_cam).project(obs[0].bearing, uv_r, &J_r)) return;
-  reference.J_pinv = J_r.transpose() * (J_r * J_r.transpose()).inverse();
-  if (!makeAlignmentTemplate(images_[ref_cam], Vec2(kr.x, kr.y), sigma_[kr.octave], options_.alignment, reference.patch)) {
+  Vec2 ref_uv(kr.x, kr.y);
+  reference.bearing = obs[0].bearing;
+  if (!makeAlignmentTemplate(images_[ref_cam], ref_uv, sigma_[kr.octave], options_.alignment, reference.patch)) {
     return;  // every partner would be NotRefinable
   }
+  bool recentred = false;
+  if (options_.recentre_reference) {
+    // The corner's pixel is where FAST found it, up to its ring's radius from the structure that the patch
+    // aligns (at a silhouette: the edge, while the pixel shows the background behind it).
+    const Vec2 moved = ref_uv + informationCentroid(reference.patch);
+    Vec3 bearing;
+    if (bearingOf(ref_cam, moved, bearing) &&
+        makeAlignmentTemplate(images_[ref_cam], moved, sigma_[kr.octave], options_.alignment, reference.patch)) {
+      ref_uv = moved;
+      reference.bearing = bearing;
+      recentred = true;
+    } else if (!makeAlignmentTemplate(images_[ref_cam], ref_uv, sigma_[kr.octave], options_.alignment, reference.patch)) {
+      return;
+    }
+  }
+  Vec2 uv_r;
+  Mat23 J_r;
+  if (!rig_.model(ref_cam).project(reference.bearing, uv_r, &J_r)) return;
+  reference.J_pinv = J_r.transpose() * (J_r * J_r.transpose()).inverse();
   bool any = false;
   for (int s = 1; s < size;) {
     const AlignmentStatus status = alignPartner(f, nodes[0], nodes[s], reference, obs[s]);
@@ -96,7 +113,14 @@ void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
     track_aligned_[t] += status == AlignmentStatus::Ok ? 1 : 0;
     ++s;
   }
-  if (any) obs[0].sigma_px = options_.alignment.sigma_floor_spacings * sigma_[kr.octave];
+  if (any) {
+    obs[0].sigma_px = options_.alignment.sigma_floor_spacings * sigma_[kr.octave];
+    if (recentred) {
+      obs[0].uv = ref_uv;
+      obs[0].bearing = reference.bearing;
+      obs[0].aligned = true;  // its keypoint moves with it
+    }
+  }
   track_size_[t] = size;
 }
 
@@ -107,14 +131,14 @@ void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
 // reference patch and the pseudo-inverse of its projection's Jacobian at the unit bearing. Fills `out` when Ok.
 AlignmentStatus MultiViewMatcher::alignPartner(const FrameFeatures& f, int ref_node, int node, const ReferencePatch& ref,
                                                Member& out) const {
-  const int r_cam = ref_node / capacity_, r_index = ref_node % capacity_;
+  const int r_cam = ref_node / capacity_;
   const int p_cam = node / capacity_, p_index = node % capacity_;
   const ImageView& image = images_[p_cam];
   if (image.empty()) return AlignmentStatus::NotRefinable;
   const SE3& T_b_r = rig_.T_b_c(r_cam);
   const SE3& T_b_p = rig_.T_b_c(p_cam);
   const CameraModel& model_p = rig_.model(p_cam);
-  const Vec3& bearing_r = f.bearings[r_cam][r_index];
+  const Vec3& bearing_r = ref.bearing;
   const Mat3 R_p_b = T_b_p.R.transpose();
   const Vec3 b = R_p_b * (T_b_r.t - T_b_p.t);
   const Vec3 m = R_p_b * (T_b_r.R * bearing_r);

@@ -127,3 +127,23 @@ TEST(EpipolarAlignment, NotRefinableWithoutTextureAlongTheDirectionOrOutsideTheI
       alignAlongEpipolar(stripes.view(), Vec2(2, 50), stripes.view(), Vec2(50, 50), Vec2(1, 0), Mat2::Identity(), 1.0, 1.0, {});
   EXPECT_EQ(outside.status, AlignmentStatus::NotRefinable);
 }
+
+// A patch of one edge measures that edge's disparity: its information lies on the edge, not at the patch's
+// centre (a corner beside a silhouette against a flat background).
+TEST(EpipolarAlignment, InformationCentroidMovesTowardTheOnlyEdge) {
+  Image step(100, 100);
+  for (int y = 0; y < 100; ++y) {
+    for (int x = 0; x < 100; ++x) step.row(y)[x] = x < 52 ? 160 : 80;  // the edge between columns 51 and 52
+  }
+  AlignmentTemplate t;
+  ASSERT_TRUE(makeAlignmentTemplate(step.view(), Vec2(49, 50), 1.0, {}, t));
+  const Vec2 c = informationCentroid(t);
+  // The central differences straddle the edge at offsets 2 and 3; with the mean removed (as the residual removes
+  // it) the other five columns keep a small share of the information: (2 * 25 * 2.5 - 5 * 4 * 1) / (50 + 20).
+  EXPECT_NEAR(c.x(), 1.5, 0.01);
+  EXPECT_NEAR(c.y(), 0.0, 1e-6);
+  // A textured patch keeps its centre.
+  const Image tex = render(Texture(5), Mat2::Identity(), Vec2::Zero(), 1.0, 0.0);
+  ASSERT_TRUE(makeAlignmentTemplate(tex.view(), Vec2(120, 100), 1.0, {}, t));
+  EXPECT_LT(informationCentroid(t).norm(), 1.0);
+}

@@ -26,6 +26,9 @@ struct DepthStats {
   int honest = 0;       // within 3 of their own reported sigmas
   int metric = 0;       // of them reported metric by the front-end (depth sigma <= 1%, verified by a third ray)
   int metric_within = 0;
+  // The judged points that miss 2%, by cause (first that applies): more than 10% off (a wrong match), at a depth
+  // discontinuity of the truth, a two-view track, else.
+  int miss_gross = 0, miss_edge = 0, miss_two_view = 0, miss_other = 0;
 };
 
 // Truth at a keypoint: the depth at its pixel, or on a depth discontinuity the depth within the keypoint's
@@ -35,7 +38,7 @@ struct DepthStats {
 // difference above 0.5% of it, far below the 2% tolerance and far above the curvature. (Before, a window
 // spanning more than 5% counted as an edge: that missed steps of 2-5%, which the 2% tolerance resolves, and
 // counted steep planes such as the floor near the horizon as edges.)
-double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, double estimate) {
+double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, double estimate, bool* edge = nullptr) {
   const double centre = test::depthAt(depth, x, y);
   if (!(centre > 0)) return centre;
   const int r = static_cast<int>(std::lround(2 * std::pow(1.2, octave)));
@@ -59,6 +62,7 @@ double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, d
       if (dy > -r && dy < r && std::abs(inverse(dx, dy - 1) - 2 * inv + inverse(dx, dy + 1)) > bound) discontinuity = true;
     }
   }
+  if (edge != nullptr) *edge = discontinuity;
   return discontinuity ? nearest : centre;
 }
 
@@ -90,7 +94,8 @@ DepthStats checkFrame(sim::Simulation& sim, int frame) {
     const KeypointRef& ref = f.mv_refs[mv.first];
     const Keypoint& kp = f.sets[ref.cam].keypoints[ref.index];
     const double z = (rig.T_b_c(ref.cam).inverse() * mv.p_b).z();
-    const double truth = trueDepth(rendered.depths[ref.cam], kp.x, kp.y, kp.octave, z);
+    bool edge = false;
+    const double truth = trueDepth(rendered.depths[ref.cam], kp.x, kp.y, kp.octave, z, &edge);
     if (!(truth > 0)) continue;  // nothing rendered there
     const double error = std::abs(z - truth) / truth;
     ++s.points;
@@ -102,6 +107,17 @@ DepthStats checkFrame(sim::Simulation& sim, int frame) {
     if (mv.relative_depth_sigma <= kJudgedAtTwoPercentSigma) {
       ++s.judged;
       s.judged_within += error < 0.02 ? 1 : 0;
+      if (!(error < 0.02)) {
+        if (error > 0.10) {
+          ++s.miss_gross;
+        } else if (edge) {
+          ++s.miss_edge;
+        } else if (mv.size == 2) {
+          ++s.miss_two_view;
+        } else {
+          ++s.miss_other;
+        }
+      }
     }
   }
   return s;
@@ -122,12 +138,18 @@ DepthStats indoorStats() {
       sum.metric_within += s.metric_within;
       sum.judged += s.judged;
       sum.judged_within += s.judged_within;
+      sum.miss_gross += s.miss_gross;
+      sum.miss_edge += s.miss_edge;
+      sum.miss_two_view += s.miss_two_view;
+      sum.miss_other += s.miss_other;
     }
     std::printf("map points %d: within 2%% %.3f, gross %.3f, within 3 sigma %.3f; metric %d, within 2%% %d\n",
                 sum.points, static_cast<double>(sum.within) / sum.points, static_cast<double>(sum.gross) / sum.points,
                 static_cast<double>(sum.honest) / sum.points, sum.metric, sum.metric_within);
     std::printf("judged at 2%% (depth sigma <= %.4f): %d points, %d within 2%% (%.4f)\n", kJudgedAtTwoPercentSigma, sum.judged, sum.judged_within,
                 static_cast<double>(sum.judged_within) / sum.judged);
+    std::printf("judged misses: %d more than 10%% off, %d at a depth discontinuity, %d two-view, %d other\n",
+                sum.miss_gross, sum.miss_edge, sum.miss_two_view, sum.miss_other);
     return sum;
   }();
   return total;
@@ -136,30 +158,30 @@ DepthStats indoorStats() {
 }  // namespace
 
 // What the front-end achieves with partners aligned to their reference keypoint along the epipolar curve
-// (MultiViewOptions::align_subpixel, off by default for its cost), regression guard: measured 3486 points, 0.935
-// within 2%, 0.015 gross, 0.916 within 3 sigmas; 2310 metric, 2248 of them within 2%; 2658 judged at 2% (sigma
-// <= 2%/3), 2596 within 2%. Without the alignment, same truth: 2147 points, 0.825 within 2%, 0.031 gross, 0.970
-// within 3 sigmas (their sigma is the octave's pixel, 3.5 times the rounding's), 10 metric, 14 with sigma <= 1%.
-// What misses now is mostly silhouettes whose patch mixes both sides (estimates 2-4% behind the foreground),
-// two-view tracks (no third ray checks them), and periodic textures whose alias is consistent along the
-// collinear front cameras.
+// (MultiViewOptions::align_subpixel, off by default), the reference moved to where its patch's information lies
+// (recentre_reference), regression guard: measured 3453 points, 0.946 within 2%, 0.012 gross, 0.926 within 3
+// sigmas; 2274 metric, 2232 of them within 2%; 2646 judged at 2% (sigma <= 2%/3), 2609 within 2% (0.986); judged
+// misses 13 more than 10% off, 7 at a discontinuity of the truth, 1 two-view, 16 else. Without the recentring:
+// 3486 points, 0.935 within 2%, 0.015 gross; 2658 judged, 2596 within 2% (0.977), misses 24 / 9 / 4 / 25: most
+// gross misses were corners 2-5 pixels beside a silhouette against a flat background, whose patch aligned the
+// silhouette's edge (the foreground's depth) while their pixel shows the background. Without the alignment,
+// same truth: 2147 points, 0.825 within 2%, 0.031 gross, 0.970 within 3 sigmas (their sigma is the octave's
+// pixel, 3.5 times the rounding's), 10 metric, 14 with sigma <= 1%.
 TEST(SimMultiViewDepth, MapPointsOfTheFrontCamerasMostlyHaveTheRenderedDepth) {
   const DepthStats s = indoorStats();
   ASSERT_GT(s.points, 3100);
-  EXPECT_GE(s.within, 0.92 * s.points);
-  EXPECT_LE(s.gross, 0.02 * s.points);
-  EXPECT_GE(s.honest, 0.90 * s.points);
-  EXPECT_GE(s.metric_within, 0.95 * s.metric);
+  EXPECT_GE(s.within, 0.93 * s.points);
+  EXPECT_LE(s.gross, 0.015 * s.points);
+  EXPECT_GE(s.honest, 0.91 * s.points);
+  EXPECT_GE(s.metric_within, 0.97 * s.metric);
   ASSERT_GT(s.judged, 2300);
-  EXPECT_GE(s.judged_within, 0.97 * s.judged);
 }
 
 // The front-end issue's target: 98% of map points within 2%, on the points that can be judged at 2% (see
-// kJudgedAtTwoPercentSigma; 76% of the map points here). Not met: 2596 of 2658 (97.7%).
-// Run with --gtest_also_run_disabled_tests.
-TEST(SimMultiViewDepth, DISABLED_MapPointsWithinTwoPercentOfTheRenderedDepth) {
+// kJudgedAtTwoPercentSigma; 77% of the map points here): met with the alignment, 2609 of 2646 (98.6%).
+TEST(SimMultiViewDepth, MapPointsWithinTwoPercentOfTheRenderedDepth) {
   const DepthStats s = indoorStats();
-  ASSERT_GT(s.judged, 2000);
+  ASSERT_GT(s.judged, 2300);
   EXPECT_GE(s.judged_within, 0.98 * s.judged);
 }
 

@@ -61,7 +61,15 @@ struct AlignmentTemplate {
   alignas(16) float value[kMaxPadded];
   alignas(16) float dx[kMaxPadded];
   alignas(16) float dy[kMaxPadded];
+  Vec2 axis = Vec2::UnitX();           // the dominant gradient's direction (main axis of the structure tensor)
 };
+
+// Where in the template the alignment's information lies, relative to its centre (reference pixels): the
+// centroid of each sample's share of the Gauss-Newton information (its squared derivative along the dominant
+// axis, mean removed as the ZNCC residual removes it), projected on that axis. A patch of one edge (a silhouette
+// against a flat background) measures the disparity of that edge, wherever its centre is: the point belongs
+// toward the edge (the fattening of window matching at depth discontinuities).
+Vec2 informationCentroid(const AlignmentTemplate& tmpl);
 
 // Samples the template of `ref` around ref_uv with the given spacing (reference pixels: the reference octave's
 // scale). Returns tmpl.ok.

@@ -39,6 +39,9 @@ struct MultiViewOptions {
   // Off by default: it costs about 5 ms of CPU per 5-camera rig frame (on the front-end's workers; main-thread
   // CPU about none; docs/benchmarks/frontend.md).
   bool align_subpixel = false;
+  // With the alignment: the reference pixel moves to where its patch's information lies (informationCentroid()),
+  // before the partners are aligned to it, so that the point is placed where its depth was measured.
+  bool recentre_reference = true;
   EpipolarAlignmentOptions alignment;
 
   MultiViewOptions() { triangulation.max_relative_depth_sigma = 0.01; }
@@ -111,6 +114,7 @@ class MultiViewMatcher {
   struct ReferencePatch {
     AlignmentTemplate patch;
     Eigen::Matrix<double, 3, 2> J_pinv;  // reference pixel offset -> bearing offset normal to the ray
+    Vec3 bearing;                        // of the reference pixel (the patch's centre)
   };
   void alignTrack(const FrameFeatures& f, int track);
   AlignmentStatus alignPartner(const FrameFeatures& f, int ref_node, int node, const ReferencePatch& ref,
