@@ -69,6 +69,28 @@ void sampleBilinear(const ImageView& im, const float* xs, const float* ys, int c
 struct Sums {
   double s[3];
 };
+#if defined(__SSE2__)
+double total(__m128 l) {
+  alignas(16) float v[4];
+  _mm_store_ps(v, l);
+  return (static_cast<double>(v[0]) + v[1]) + (static_cast<double>(v[2]) + v[3]);
+}
+Sums dot3(const float* d, const float* a, const float* b, int padded) {
+  __m128 l0 = _mm_setzero_ps(), l1 = _mm_setzero_ps(), l2 = _mm_setzero_ps();
+  for (int g = 0; g < padded; g += 4) {
+    const __m128 v = _mm_load_ps(d + g);
+    l0 = _mm_add_ps(l0, _mm_mul_ps(v, v));
+    l1 = _mm_add_ps(l1, _mm_mul_ps(v, _mm_load_ps(a + g)));
+    l2 = _mm_add_ps(l2, _mm_mul_ps(v, _mm_load_ps(b + g)));
+  }
+  return {{total(l0), total(l1), total(l2)}};
+}
+double sum(const float* v, int padded) {
+  __m128 l = _mm_setzero_ps();
+  for (int g = 0; g < padded; g += 4) l = _mm_add_ps(l, _mm_load_ps(v + g));
+  return total(l);
+}
+#else
 Sums dot3(const float* d, const float* a, const float* b, int padded) {
   float l0[4] = {}, l1[4] = {}, l2[4] = {};
   for (int g = 0; g < padded; g += 4) {
@@ -82,7 +104,6 @@ Sums dot3(const float* d, const float* a, const float* b, int padded) {
   auto total = [](const float* l) { return (static_cast<double>(l[0]) + l[1]) + (static_cast<double>(l[2]) + l[3]); };
   return {{total(l0), total(l1), total(l2)}};
 }
-
 double sum(const float* v, int padded) {
   float l[4] = {};
   for (int g = 0; g < padded; g += 4) {
@@ -90,6 +111,7 @@ double sum(const float* v, int padded) {
   }
   return (static_cast<double>(l[0]) + l[1]) + (static_cast<double>(l[2]) + l[3]);
 }
+#endif
 
 }  // namespace
 
@@ -106,10 +128,16 @@ bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spac
   // The reference patch on its grid, one ring more for the central differences.
   const int side = 2 * h + 3, grid = side * side, grid_padded = (grid + 3) / 4 * 4;
   alignas(16) float gx[kMaxGridPadded], gy[kMaxGridPadded], g[kMaxGridPadded];
-  for (int k = 0; k < grid_padded; ++k) {
-    const int i = k < grid ? k % side : h + 1, j = k < grid ? k / side : h + 1;  // padding: the centre
-    gx[k] = static_cast<float>(ref_uv.x() + spacing * (i - h - 1));
-    gy[k] = static_cast<float>(ref_uv.y() + spacing * (j - h - 1));
+  for (int j = 0, k = 0; j < side; ++j) {
+    const float y = static_cast<float>(ref_uv.y() + spacing * (j - h - 1));
+    for (int i = 0; i < side; ++i, ++k) {
+      gx[k] = static_cast<float>(ref_uv.x() + spacing * (i - h - 1));
+      gy[k] = y;
+    }
+  }
+  for (int k = grid; k < grid_padded; ++k) {  // padding: the centre
+    gx[k] = static_cast<float>(ref_uv.x());
+    gy[k] = static_cast<float>(ref_uv.y());
   }
   sampleBilinear(ref, gx, gy, grid_padded, g);
   const float inv_2s = static_cast<float>(1.0 / (2 * spacing));
