@@ -22,7 +22,7 @@ int MultiViewMatcher::alignTaskCount() const {
 void MultiViewMatcher::alignTracks(const FrameFeatures& f, int task) {
   const int begin = task * kTracksPerAlignTask, end = std::min(track_count_, begin + kTracksPerAlignTask);
   for (int t = begin; t < end; ++t) {
-    if (t + 1 < track_count_) prefetchPatches(f, t + 1);
+    if (t + 1 < end) prefetchPatches(f, t + 1);  // not beyond the task: another thread may be reordering it
     alignTrack(f, t);
   }
 }
