@@ -68,7 +68,7 @@ void progress(std::size_t done, std::size_t total, double ms_per_frame, const Po
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
   std::string dataset_dir, calibration_path, config_path, cameras_text, out_path, keyframes_path, stats_path, extrinsics_path;
-  bool quiet = false, print_config = false, overlap = false;
+  bool quiet = false, print_config = false, overlap = true;
   std::string log_level = "info";
   std::size_t max_frames = 0;
   app.add_option("--dataset", dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
@@ -86,9 +86,10 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "Log of the pipeline's events (debug: also each scale estimate of a rig "
                                            "without overlap)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
-  app.add_flag("--overlap", overlap,
-               "Run the front-end of the next frame while the odometry works on this one (same output; on our 2-core "
-               "machine 15-20% faster when nothing else runs, slower under competing load: see BENCHMARKS.md)");
+  app.add_flag("--overlap,!--no-overlap", overlap,
+               "Run the front-end of the next frame while the odometry works on this one (the default; same output). "
+               "--no-overlap: one stage after the other, which can be faster on a machine busy with other work "
+               "(BENCHMARKS.md)");
   app.add_flag("--print-config", print_config,
                "Print the effective `slam:` configuration (defaults, --config, this dataset's rig) and exit");
   CLI11_PARSE(app, argc, argv);
@@ -117,7 +118,7 @@ int main(int argc, char** argv) {
     }
 
     // Images are decoded one frame ahead on their own thread. The front-end of frame i+1 runs after the odometry of
-    // frame i or, with --overlap, during it (on another thread): the two stages share no state, so the output is the
+    // frame i or, by default (--overlap), during it (on another thread): the two stages share no state, so the output is the
     // same either way.
     FrameFeatures buffers[2] = {pipeline.makeFrameFeatures(), pipeline.makeFrameFeatures()};
     std::future<DatasetFrame> next_load = std::async(std::launch::async, loadFrame, std::cref(ds), std::size_t{0});

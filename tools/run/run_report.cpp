@@ -102,7 +102,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("cameras").value(cameras);
   j.key("frames").value(static_cast<unsigned long long>(frames_.size()));
   j.key("wall_seconds").value(wall_seconds);
-  // Throughput (with --overlap it can be below the per-frame latency, timing_ms.total).
+  // Throughput (with the stages overlapping, the default, it can be below the per-frame latency, timing_ms.total).
   j.key("wall_ms_per_frame").value(frames_.empty() ? 0.0 : 1000.0 * wall_seconds / static_cast<double>(frames_.size()));
   j.key("tracking_states").beginObject();
   j.key("tracking").value(state_count[static_cast<int>(TrackingState::Tracking)]);
