@@ -21,12 +21,16 @@ backend::WindowCapacity windowCapacity(const OdometryOptions& o, const Map& map,
   return cap;
 }
 
+// Oldest keyframes the back-end holds: two when the map's scale is not the window's to change (one camera has no
+// metric scale; a remembered scale is held), else one.
+int gaugeFixedOldest(bool monocular, bool hold_scale) { return monocular || hold_scale ? 2 : 1; }
+
 backend::SolverOptions solverOptions(const OdometryOptions& o, bool monocular) {
   backend::SolverOptions so;
   so.refine_extrinsics = o.refine_extrinsics;
   so.extrinsic_prior.translation = o.extrinsic_sigma_translation;
   so.extrinsic_prior.rotation = o.extrinsic_sigma_rotation_deg * M_PI / 180.0;
-  so.gauge_fixed_oldest = monocular ? 2 : 1;  // a monocular map also has a free scale
+  so.gauge_fixed_oldest = gaugeFixedOldest(monocular, false);
   return so;
 }
 
@@ -100,7 +104,7 @@ void LocalMapper::rescale(double s, const Vec3& center) {
 }
 
 void LocalMapper::holdScale(bool hold) {
-  if (solver_) solver_->setGaugeFixedOldest(hold || monocular_ ? 2 : 1);
+  if (solver_) solver_->setGaugeFixedOldest(gaugeFixedOldest(monocular_, hold));
 }
 
 Rig LocalMapper::refinedRig() const {

@@ -21,6 +21,7 @@ ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observ
     : rig_(rig) {
   for (int o = 0; o < std::max(levels, 1); ++o) octave_sigma_.push_back(std::pow(octave_scale_factor, o));
   kf_T_.resize(kMaxKeyframes);
+  T_c_b_.resize(rig.size());
   lm_p_.resize(max_landmarks);
   lm_first_.resize(static_cast<std::size_t>(max_landmarks) + 1);
   obs_.resize(max_observations);
@@ -85,7 +86,6 @@ double ScaleEstimator::scaleOfPoses() const {
 
 bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residuals) {
   const int dim = 6 * (nk_ - 1);
-  auto freeIndex = [&](int w) { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); };
   S_.setZero(dim, dim);
   b_.setZero(dim);
   chi2 = 0;
@@ -105,8 +105,8 @@ bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residual
       const Obs& o = obs_[i];
       Vec2 r;
       backend::ReprojectionJacobians J;
-      if (!backend::reprojectionResidualInverse(rig_.model(o.cam), T_b_w[o.kf], rig_.T_b_c(o.cam).inverse(), p, o.uv,
-                                                o.inv_sigma, r, &J)) {
+      if (!backend::reprojectionResidualInverse(rig_.model(o.cam), T_b_w[o.kf], T_c_b_[o.cam], p, o.uv, o.inv_sigma, r,
+                                                &J)) {
         continue;
       }
       double rho, wt;
@@ -151,6 +151,7 @@ bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residual
 
 ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   ScaleEstimate out;
+  for (int c = 0; c < rig_.size(); ++c) T_c_b_[c] = rig_.T_b_c(c).inverse();
   // The window's keyframes; the oldest is the centre (the back-end holds it fixed).
   kf_slot_of_.assign(map.keyframeCapacity(), -1);  // sized once: the map's capacity does not change
   nk_ = 0;
@@ -245,7 +246,6 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   for (int l = 0; l < nl_; ++l) lm_p_[l] *= s_coarse;
 
   // 2. Fine: Gauss-Newton on the whole window; the last system gives the marginal sigma.
-  const auto freeIndex = [&](int w) { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); };
   ReducedVec step;
   double chi2 = 0, first_chi2 = 0, last_u_step = 0;
   int residuals = 0;

@@ -49,7 +49,7 @@ class ScaleEstimator {
   using Reduced = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDim, kMaxDim>;
   using ReducedVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDim, 1>;
   struct Obs {
-    int16_t kf;   // index into kf_R_/kf_t_
+    int16_t kf;   // index into kf_T_
     int16_t cam;
     Vec2 uv;
     double inv_sigma;
@@ -61,10 +61,14 @@ class ScaleEstimator {
   // variance of u it implies. False when singular.
   bool reducedSystem(ReducedVec& step, double& chi2, int& residuals);
   double scaleOfPoses() const;  // summed distances of the keyframes from the oldest (the centre)
+  // Block of window keyframe w in the reduced pose system (-1: the oldest, held).
+  int freeIndex(int w) const { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); }
 
   const Rig& rig_;
   backend::RobustLoss loss_;
   std::vector<double> octave_sigma_;
+  std::vector<SE3> T_c_b_;     // per camera, from the rig at the start of estimate() (its extrinsics may follow
+                               // the back-end's)
   std::vector<SE3> kf_T_;      // per window keyframe: T_w_b, translation relative to the centre
   int oldest_ = 0;              // window index of the oldest keyframe (held)
   Reduced S_;
