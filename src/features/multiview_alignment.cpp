@@ -87,13 +87,15 @@ void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
     // aligns (at a silhouette: the edge, while the pixel shows the background behind it).
     const Vec2 moved = ref_uv + informationCentroid(reference.patch);
     Vec3 bearing;
-    if (bearingOf(ref_cam, moved, bearing) &&
-        makeAlignmentTemplate(images_[ref_cam], moved, sigma_[kr.octave], options_.alignment, reference.patch)) {
-      ref_uv = moved;
-      reference.bearing = bearing;
-      recentred = true;
-    } else if (!makeAlignmentTemplate(images_[ref_cam], ref_uv, sigma_[kr.octave], options_.alignment, reference.patch)) {
-      return;
+    if (bearingOf(ref_cam, moved, bearing)) {
+      if (makeAlignmentTemplate(images_[ref_cam], moved, sigma_[kr.octave], options_.alignment, reference.patch)) {
+        ref_uv = moved;
+        reference.bearing = bearing;
+        recentred = true;
+      } else if (!makeAlignmentTemplate(images_[ref_cam], ref_uv, sigma_[kr.octave], options_.alignment,
+                                        reference.patch)) {  // the failed attempt overwrote it: sampled again
+        return;
+      }
     }
   }
   Vec2 uv_r;
