@@ -24,27 +24,23 @@ struct ImageSize {
   int width = 0, height = 0;
 };
 
-// Work of a rig frame that depends on extracted cameras, run on the same threads so that it fills their idle
-// time (five cameras on two threads leave one thread idle during the last camera).
-class ExtractionFollowUp {
- public:
-  virtual ~ExtractionFollowUp() = default;
-  // On the thread that extracted `camera` (absent or not), right after it.
-  virtual void afterCamera(int camera) = 0;
-  // The frame's tasks: task t starts once afterCamera() returned for both of its cameras; `thread` is the
-  // worker's index, so that concurrent tasks use distinct scratch.
-  virtual int taskCount() const = 0;
-  virtual std::pair<int, int> taskCameras(int task) const = 0;
-  virtual void runTask(int task, int thread) = 0;
-};
-
-// Independent tasks run on the workers outside extract() (FeatureWorkers::runTasks()).
+// Independent tasks run on the workers (FeatureWorkers::runTasks()), each once.
 class WorkerTasks {
  public:
   virtual ~WorkerTasks() = default;
   virtual int taskCount() const = 0;
   // `thread` is the worker's index, so that concurrent tasks may use distinct scratch.
   virtual void runTask(int task, int thread) = 0;
+};
+
+// Work of a rig frame that depends on extracted cameras, run on the same threads so that it fills their idle
+// time (five cameras on two threads leave one thread idle during the last camera). Its tasks (taskCount(),
+// runTask()) are the frame's: task t starts once afterCamera() returned for both of its cameras.
+class ExtractionFollowUp : public WorkerTasks {
+ public:
+  // On the thread that extracted `camera` (absent or not), right after it.
+  virtual void afterCamera(int camera) = 0;
+  virtual std::pair<int, int> taskCameras(int task) const = 0;
 };
 
 class FeatureWorkers {
