@@ -227,10 +227,11 @@ void Odometry::estimateScale() {
   spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks), combined "
                 "{:.4f} sigma {:.4f}", frame_index_, e.scale, e.relative_sigma, e.keyframes, e.landmarks, std::exp(x),
                 sigma);
-  // Until the combined sigma reaches the bound nothing is applied (the back-end's own window pulls the scale
-  // meanwhile); afterwards a correction 3 sigma away from 1 is.
+  // A correction 3 sigma away from 1 is applied at any time: before convergence it brings the arbitrary unit near
+  // the metric one (the windows' Gauss-Newton then starts in the basin; a unit 8x off left most windows without
+  // an estimate), the poses staying flagged unscaled until the combined sigma reaches the bound.
   const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma;
-  if (!converges && !(scale_converged_ && std::abs(x) > 3.0 * sigma)) return;
+  if (!converges && !(std::abs(x) > 3.0 * sigma)) return;
   // The whole live map, the window and the motion model take the new unit at once.
   const double s = std::exp(x);
   mapper_->rescale(s, e.center);
@@ -241,10 +242,6 @@ void Odometry::estimateScale() {
   ++stats_.scale_rescales;
   if (converges) {
     scale_converged_ = true;
-    // From now on the window holds this scale (its two oldest keyframes fixed) and only these estimates change
-    // it: left free, it random-walked wherever no turn constrained it (the 33 cm rig's map shrank to a tenth
-    // on a straight stretch). resetMap() lets it go with the window.
-    mapper_->holdScale(true);
     stats_.scale_converged_frame = static_cast<int64_t>(frame_index_);
   }
 }
@@ -295,6 +292,11 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   initialized_ = true;
   scale_converged_ = metric;
   scale_free_start_ = !metric;
+  // A map that starts up to scale keeps its unit (the window's two oldest keyframes fixed, as for one camera)
+  // and only the estimates of estimateScale() change it. A free window random-walked its scale wherever no turn
+  // constrained it: the 33 cm rig's map shrank to a tenth on a straight stretch, the 10 cm rig lost track.
+  // resetMap() lets it go with the window.
+  if (!metric && rig_.size() > 1) mapper_->holdScale(true);
   keyframes_since_scale_ = 0;
   if (scale_filter_) scale_filter_->reset();
   ++stats_.initializations;

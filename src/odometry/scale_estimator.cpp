@@ -140,12 +140,16 @@ bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residual
     const Vec3 d = kf_T_[w].t - kf_T_[oldest_].t;
     if (f >= 0 && d.norm() > 0) g_.segment<3>(6 * f) = kf_T_[w].R.transpose() * d / (d.norm() * sum);
   }
+  // The variance of u (in units of the pixel sigmas) from the undamped system. The damping below only steadies
+  // the step: where the window does not constrain the scale it would pose as information (measured: a straight
+  // synthetic window's sigma 5360% became 21%; a window of the rendered 10 cm rig 93% became 3.8%).
+  const Eigen::LDLT<Reduced> exact(S_);
+  scale_variance_ = exact.info() == Eigen::Success ? g_.dot(exact.solve(g_)) : INFINITY;
+  if (!(scale_variance_ > 0)) scale_variance_ = INFINITY;  // singular or indefinite: the scale is not observed
   S_.diagonal().array() += 1e-9 + 1e-6 * S_.diagonal().array();
   const Eigen::LDLT<Reduced> ldlt(S_);
   if (ldlt.info() != Eigen::Success) return false;
   step = ldlt.solve(-b_);
-  const ReducedVec Sg = ldlt.solve(g_);
-  scale_variance_ = g_.dot(Sg);  // of u, in units of the pixel sigmas
   return step.allFinite() && std::isfinite(scale_variance_);
 }
 

@@ -78,8 +78,9 @@ TEST(ScaleEstimator, FindsTheMetricScaleOfATurningWindow) {
   }
 }
 
-// Without rotation the lever arms move with the body and the scale stays unknown: a large sigma, never a
-// confident wrong answer.
+// Without rotation the lever arms move with the body and the scale stays unknown: a sigma far above 100%
+// (about 5000% here) or no estimate, never a confident wrong answer. The damping that steadies the Gauss-Newton
+// step once posed as information here (21%).
 TEST(ScaleEstimator, StraightWindowLeavesTheScaleOpen) {
   const Rig rig = test::nonOverlappingRig3();
   Map map(rig, 2000, 14, 4000);
@@ -87,5 +88,5 @@ TEST(ScaleEstimator, StraightWindowLeavesTheScaleOpen) {
   ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 1.2f, 8);
   const ScaleEstimate e = est.estimate(map, 30.0);
   std::printf("straight: ok %d estimate %.4f sigma %.4f\n", e.ok, e.scale, e.relative_sigma);
-  EXPECT_TRUE(!e.ok || e.relative_sigma > 0.2);
+  EXPECT_TRUE(!e.ok || e.relative_sigma > 1.0);
 }
