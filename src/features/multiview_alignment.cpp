@@ -24,6 +24,8 @@ void MultiViewMatcher::alignTracks(const FrameFeatures& f, int task) {
   for (int t = begin; t < end; ++t) {
     if (t + 1 < end) prefetchPatches(f, t + 1);  // not beyond the task: another thread may be reordering it
     alignTrack(f, t);
+    // Solved here too: the triangulation is most of the emission's work, and the workers share it.
+    track_solution_[t] = solveTrack(f, members_.data() + track_first_[t], aligned_obs_.data() + track_first_[t], track_size_[t]);
   }
 }
 

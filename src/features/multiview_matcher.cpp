@@ -121,13 +121,12 @@ MultiViewMatcher::MultiViewMatcher(const Rig& rig, const OverlapMap& overlap, co
   component_size_.resize(parent_.size());
   members_.resize(parent_.size());
   distance_count_.resize(258);
-  scratch_obs_.resize(n);
-  members_obs_.resize(n);
   track_first_.resize(parent_.size());
   track_size_.resize(parent_.size());
   track_aligned_.resize(parent_.size());
   track_disagreeing_.resize(parent_.size());
   aligned_obs_.resize(parent_.size());
+  track_solution_.resize(parent_.size());
 }
 
 void MultiViewMatcher::compute(FrameFeatures& f, const ImageView* images) {
@@ -518,56 +517,53 @@ void MultiViewMatcher::mergeTracks(FrameFeatures& f) {
 // The tracks in member order, each into f.mv_refs from its current end (a dropped track leaves no trace).
 void MultiViewMatcher::emitTracks(FrameFeatures& f) {
   for (int t = 0; t < track_count_; ++t) {
-    const int first = f.mv_ref_count, size = track_size_[t];
-    const int32_t* nodes = members_.data() + track_first_[t];
-    for (int s = 0; s < size; ++s) {
-      f.mv_refs[first + s] = KeypointRef{static_cast<int16_t>(nodes[s] / capacity_), nodes[s] % capacity_};
-      if (aligned_frame_) {
-        members_obs_[s] = aligned_obs_[track_first_[t] + s];
-      } else {
-        const KeypointRef& r = f.mv_refs[first + s];
-        const Keypoint& kp = f.sets[r.cam].keypoints[r.index];
-        members_obs_[s] = Member{Vec2(kp.x, kp.y), f.bearings[r.cam][r.index], sigma_[kp.octave], false};
-      }
-    }
+    int32_t* nodes = members_.data() + track_first_[t];
+    Member* obs = aligned_obs_.data() + track_first_[t];
+    TrackSolution solution;
     if (aligned_frame_) {
+      solution = track_solution_[t];  // solved by alignTracks()
       stats_.aligned += track_aligned_[t];
       stats_.disagreeing += track_disagreeing_[t];
+    } else {
+      for (int s = 0; s < track_size_[t]; ++s) {
+        const Keypoint& kp = f.sets[nodes[s] / capacity_].keypoints[nodes[s] % capacity_];
+        obs[s] = Member{Vec2(kp.x, kp.y), f.bearings[nodes[s] / capacity_][nodes[s] % capacity_], sigma_[kp.octave], false};
+      }
+      solution = solveTrack(f, nodes, obs, track_size_[t]);
     }
-    finishTrack(f, first, size);
+    emitTrack(f, nodes, obs, solution);
   }
   images_ = nullptr;
   aligned_frame_ = false;
 }
 
-void MultiViewMatcher::swapMembers(FrameFeatures& f, int first, int a, int b) {
-  std::swap(f.mv_refs[first + a], f.mv_refs[first + b]);
-  std::swap(members_obs_[a], members_obs_[b]);
-}
-
-// The track's members are in f.mv_refs[first, first + size) and their observations in members_obs_.
-void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
+// Triangulates a track from its members' observations and decides whether it stays a multi-view feature. Reads
+// only the frame and the track; reorders the track's nodes and observations in place (a member that disagrees
+// moves past the returned size), so tracks may be solved on any threads.
+MultiViewMatcher::TrackSolution MultiViewMatcher::solveTrack(const FrameFeatures& f, int32_t* nodes, Member* obs,
+                                                             int size) const {
+  TriangulationObservation tri_obs[64];  // at most one member per camera, at most 64 cameras
   auto fillObservations = [&](int n) {
     for (int s = 0; s < n; ++s) {
-      const KeypointRef& r = f.mv_refs[first + s];
-      TriangulationObservation& o = scratch_obs_[s];
-      o.model = &rig_.model(r.cam);
-      o.T_f_c = rig_.T_b_c(r.cam);
-      o.uv = members_obs_[s].uv;
-      o.bearing = members_obs_[s].bearing;
-      o.sigma_px = members_obs_[s].sigma_px;
+      const int cam = nodes[s] / capacity_;
+      TriangulationObservation& o = tri_obs[s];
+      o.model = &rig_.model(cam);
+      o.T_f_c = rig_.T_b_c(cam);
+      o.uv = obs[s].uv;
+      o.bearing = obs[s].bearing;
+      o.sigma_px = obs[s].sigma_px;
     }
   };
   TriangulationResult tri;
   for (;;) {
     fillObservations(size);
-    tri = triangulate(scratch_obs_.data(), size, options_.triangulation);
+    tri = triangulate(tri_obs, size, options_.triangulation);
     if (tri.status != TriangulationStatus::LargeReprojection || size <= 2) break;
     // One keypoint disagrees: drop the worst and try again.
     int worst = 0;
     double worst_err = -1;
     for (int s = 0; s < size; ++s) {
-      const TriangulationObservation& o = scratch_obs_[s];
+      const TriangulationObservation& o = tri_obs[s];
       Vec2 uv;
       const double e = o.model->project(o.T_f_c.inverse() * tri.point, uv) ? (uv - o.uv).norm() / o.sigma_px : 1e9;
       if (e > worst_err) {
@@ -575,16 +571,19 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
         worst = s;
       }
     }
-    swapMembers(f, first, worst, size - 1);
+    std::swap(nodes[worst], nodes[size - 1]);
+    std::swap(obs[worst], obs[size - 1]);
     --size;
   }
-  bool keep = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain ||
-                    tri.status == TriangulationStatus::LowParallax;
-  bool has_point = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain;
-  if (keep && has_point && size == 2 && options_.two_view_visibility_check) {
-    const int c0 = f.mv_refs[first].cam, c1 = f.mv_refs[first + 1].cam;
+  TrackSolution out;
+  out.size = static_cast<int16_t>(size);
+  out.keep = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain ||
+             tri.status == TriangulationStatus::LowParallax;
+  out.has_point = tri.status == TriangulationStatus::Ok || tri.status == TriangulationStatus::Uncertain;
+  if (out.keep && out.has_point && size == 2 && options_.two_view_visibility_check) {
+    const int c0 = nodes[0] / capacity_, c1 = nodes[1] / capacity_;
     const double baseline = (rig_.T_b_c(c0).t - rig_.T_b_c(c1).t).norm();
-    for (int c = 0; c < f.cameras() && keep; ++c) {
+    for (int c = 0; c < f.cameras() && out.keep; ++c) {
       if (c == c0 || c == c1 || !f.present[c]) continue;
       // Only a camera nearer to one of the two than they are to each other: its view differs less from
       // theirs than they differ from each other, so it would have matched a true corner more easily.
@@ -601,47 +600,56 @@ void MultiViewMatcher::finishTrack(FrameFeatures& f, int first, int size) {
       if (!model.project(p_c, uv)) continue;
       const double m = options_.visibility_margin_px;
       if (uv.x() >= m && uv.y() >= m && uv.x() <= model.width() - 1 - m && uv.y() <= model.height() - 1 - m) {
-        keep = false;  // a camera that should see the point has no keypoint in the track
+        out.keep = false;  // a camera that should see the point has no keypoint in the track
       }
     }
   }
-  if (!keep) {
+  if (!out.keep) return out;
+  out.metric = tri.status == TriangulationStatus::Ok && size >= min_metric_views_;
+  out.point = tri.point;
+  out.relative_depth_sigma = static_cast<float>(tri.relative_depth_sigma);
+  // Representative descriptor: the medoid (least total Hamming distance to the others).
+  int best_sum = 1 << 30;
+  for (int a = 0; a < size; ++a) {
+    const Descriptor& da = f.sets[nodes[a] / capacity_].descriptors[nodes[a] % capacity_];
+    int sum = 0;
+    for (int b = 0; b < size; ++b) sum += hammingDistance(da, f.sets[nodes[b] / capacity_].descriptors[nodes[b] % capacity_]);
+    if (sum < best_sum) {
+      best_sum = sum;
+      out.medoid = static_cast<int16_t>(a);
+    }
+  }
+  return out;
+}
+
+// A solved track into f: its members in f.mv_refs from the current end, aligned keypoints moved, the feature.
+void MultiViewMatcher::emitTrack(FrameFeatures& f, const int32_t* nodes, const Member* obs, const TrackSolution& solution) {
+  if (!solution.keep) {
     ++stats_.dropped;
     return;  // its keypoints stay mono features
   }
-  // Aligned partners keep their aligned position: the odometry observes the point where the track saw it.
+  const int first = f.mv_ref_count, size = solution.size;
   for (int s = 0; s < size; ++s) {
-    if (!members_obs_[s].aligned) continue;
-    const KeypointRef& r = f.mv_refs[first + s];
-    Keypoint& kp = f.sets[r.cam].keypoints[r.index];
-    kp.x = static_cast<float>(members_obs_[s].uv.x());
-    kp.y = static_cast<float>(members_obs_[s].uv.y());
-    f.bearings[r.cam][r.index] = members_obs_[s].bearing;
+    KeypointRef& r = f.mv_refs[first + s];
+    r = KeypointRef{static_cast<int16_t>(nodes[s] / capacity_), nodes[s] % capacity_};
+    // Aligned partners keep their aligned position: the odometry observes the point where the track saw it.
+    if (obs[s].aligned) {
+      Keypoint& kp = f.sets[r.cam].keypoints[r.index];
+      kp.x = static_cast<float>(obs[s].uv.x());
+      kp.y = static_cast<float>(obs[s].uv.y());
+      f.bearings[r.cam][r.index] = obs[s].bearing;
+    }
+    f.mv_of[r.cam][r.index] = f.mv_count;
   }
   MultiViewFeature& mv = f.mv[f.mv_count];
   mv.first = first;
   mv.size = static_cast<int16_t>(size);
-  mv.has_point = has_point;
-  mv.metric = tri.status == TriangulationStatus::Ok && size >= min_metric_views_;
-  mv.p_b = tri.point;
-  mv.relative_depth_sigma = static_cast<float>(tri.relative_depth_sigma);
-  // Representative descriptor: the medoid (least total Hamming distance to the others).
-  int best = 0, best_sum = 1 << 30;
-  for (int a = 0; a < size; ++a) {
-    const KeypointRef& ra = f.mv_refs[first + a];
-    int sum = 0;
-    for (int b = 0; b < size; ++b) {
-      const KeypointRef& rb = f.mv_refs[first + b];
-      sum += hammingDistance(f.sets[ra.cam].descriptors[ra.index], f.sets[rb.cam].descriptors[rb.index]);
-    }
-    if (sum < best_sum) {
-      best_sum = sum;
-      best = a;
-    }
-  }
-  const KeypointRef& rm = f.mv_refs[first + best];
+  mv.has_point = solution.has_point;
+  mv.metric = solution.metric;
+  mv.p_b = solution.point;
+  mv.relative_depth_sigma = solution.relative_depth_sigma;
+  const KeypointRef& rm = f.mv_refs[first + solution.medoid];
   mv.descriptor = f.sets[rm.cam].descriptors[rm.index];
-  for (int s = 0; s < size; ++s) f.mv_of[f.mv_refs[first + s].cam][f.mv_refs[first + s].index] = f.mv_count;
   ++f.mv_count;
   f.mv_ref_count += size;
   ++stats_.tracks;

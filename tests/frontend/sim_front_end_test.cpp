@@ -1,6 +1,7 @@
 // The front-end spreads the multi-view matcher's cameras and pairs over its ORB workers: its features must be
 // exactly those of the sequential path (each camera extracted alone, then MultiViewMatcher::compute()), for
-// any thread count, with a camera absent too, and with the subpixel alignment of the partners on.
+// any thread count, with a camera absent too, and with the subpixel alignment of the partners on (its tasks also
+// triangulate the tracks they aligned, in any order).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -89,6 +90,42 @@ TEST(FrontEnd, MatchingOnTheWorkersGivesTheSequentialFeatures) {
       }
     }
   }
+}
+
+// The alignment's tasks triangulate and judge the tracks they aligned (MultiViewMatcher::solveTrack) for the
+// emission: in reverse order they must give compute()'s features and counts (nothing carried from task to task).
+TEST(FrontEnd, AlignmentTasksInReverseOrderGiveTheSameTracks) {
+  sim::Simulation& sim = test::sharedSimulation("isec", "indoor");
+  const std::vector<int> front = {0, 1, 2, 3, 4};
+  const Rig rig = sim.rig().subset(front);
+  const test::RenderedFrame rendered = test::renderFrame(sim, sim.frameCount() / 3, front);
+  PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
+  config.multiview.align_subpixel = true;
+  const OverlapMap overlap(rig, config.overlap);
+  FrameFeatures expected(rig.size(), config.orb.max_features);
+  for (int c = 0; c < rig.size(); ++c) {
+    expected.present[c] = 1;
+    OrbExtractor extractor(config.orb, rig.model(c).width(), rig.model(c).height());
+    ASSERT_EQ(extractor.extract(rendered.view().images[c], expected.sets[c]), OrbStatus::kOk);
+  }
+  FrameFeatures f = expected;
+  MultiViewMatcher reference(rig, overlap, config.multiview, config.orb.max_features);
+  reference.compute(expected, rendered.view().images);
+
+  MultiViewMatcher matcher(rig, overlap, config.multiview, config.orb.max_features);
+  matcher.beginFrame(f, rendered.view().images);
+  for (int c = 0; c < rig.size(); ++c) matcher.prepareCamera(f, c);
+  for (int p = 0; p < matcher.pairCount(); ++p) matcher.matchPair(f, p, 0);
+  matcher.mergeFrame(f);
+  ASSERT_GT(matcher.alignTaskCount(), 2);
+  for (int task = matcher.alignTaskCount() - 1; task >= 0; --task) matcher.alignTracks(f, task);
+  matcher.emitTracks(f);
+  expectSameFeatures(expected, f);
+  EXPECT_GT(reference.stats().dropped, 0);
+  EXPECT_EQ(matcher.stats().dropped, reference.stats().dropped);
+  EXPECT_EQ(matcher.stats().tracks_with_point, reference.stats().tracks_with_point);
+  EXPECT_EQ(matcher.stats().metric_tracks, reference.stats().metric_tracks);
+  EXPECT_EQ(matcher.stats().aligned, reference.stats().aligned);
 }
 
 }  // namespace

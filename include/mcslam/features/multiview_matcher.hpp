@@ -83,8 +83,8 @@ class MultiViewMatcher {
   void matchPair(const FrameFeatures& frame, int pair, int thread);
   void finishFrame(FrameFeatures& frame);
   // finishFrame() in steps, for callers that run the subpixel alignment on their threads: mergeFrame();
-  // alignTracks() for every task below alignTaskCount() (0 when the alignment is off or has no images), in any
-  // order and on any threads, each task once; emitTracks(). The result is finishFrame()'s, whatever the threads.
+  // alignTracks() (which also triangulates the tracks it aligned) for every task below alignTaskCount() (0 when
+  // the alignment is off or has no images), in any order and on any threads, each task once; emitTracks(). The result is finishFrame()'s, whatever the threads.
   void mergeFrame(FrameFeatures& frame);
   int alignTaskCount() const;
   void alignTracks(const FrameFeatures& frame, int task);
@@ -103,14 +103,23 @@ class MultiViewMatcher {
   void noteForB(const FeatureSet& si, int b, int a, int d, PairScratch& s) const;
   void gatherMatches();
   void mergeTracks(FrameFeatures& f);
-  void finishTrack(FrameFeatures& f, int first, int size);
-  // The current track's observations (parallel to its mv_refs): position, bearing and sigma after alignment.
+  // A track member's observation: position, bearing and sigma (after the alignment, when it ran).
   struct Member {
     Vec2 uv;
     Vec3 bearing;
     double sigma_px;
     bool aligned;
   };
+  // A track's triangulation and the decision to keep it; its first `size` members are the kept ones.
+  struct TrackSolution {
+    Vec3 point = Vec3::Zero();
+    float relative_depth_sigma = 0;
+    int16_t size = 0;
+    int16_t medoid = 0;  // the member whose descriptor represents the track
+    bool keep = false, has_point = false, metric = false;
+  };
+  TrackSolution solveTrack(const FrameFeatures& f, int32_t* nodes, Member* obs, int size) const;
+  void emitTrack(FrameFeatures& f, const int32_t* nodes, const Member* obs, const TrackSolution& solution);
   struct ReferencePatch {
     AlignmentTemplate patch;
     Eigen::Matrix<double, 3, 2> J_pinv;  // reference pixel offset -> bearing offset normal to the ray
@@ -120,7 +129,6 @@ class MultiViewMatcher {
   AlignmentStatus alignPartner(const FrameFeatures& f, int ref_node, int node, const ReferencePatch& ref,
                                Member& out) const;
   void prefetchPatches(const FrameFeatures& f, int track) const;
-  void swapMembers(FrameFeatures& f, int first, int a, int b);
   bool bearingOf(int cam, const Vec2& uv, Vec3& bearing) const;
   int find(int node);
 
@@ -183,17 +191,16 @@ class MultiViewMatcher {
   std::vector<int32_t> component_of_root_;
   std::vector<int32_t> component_size_;
   std::vector<int32_t> members_;         // nodes grouped by component
-  std::vector<TriangulationObservation> scratch_obs_;
-  std::vector<Member> members_obs_;
   // The tracks of the frame (mergeFrame()): members_[first, first + size) each, the reference first and the
   // partners that disagree moved past the size once aligned; per track the alignment's counts, per member of
-  // members_ its observation after the alignment.
+  // members_ its observation (after the alignment; scratch of the emission without it).
   int track_count_ = 0;
   std::vector<int32_t> track_first_;
   std::vector<int32_t> track_size_;
   std::vector<int16_t> track_aligned_;
   std::vector<int16_t> track_disagreeing_;
   std::vector<Member> aligned_obs_;
+  std::vector<TrackSolution> track_solution_;  // per track, when aligned: solved on the alignment's threads
   bool aligned_frame_ = false;  // this frame's tracks are aligned (alignment on, images given)
   const ImageView* images_ = nullptr;  // the current frame's, during compute()
 };
