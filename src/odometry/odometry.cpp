@@ -207,12 +207,33 @@ void Odometry::finishKeyframe(int slot) {
   timing_.mapping_ms += msSince(cull_start);
 }
 
+double Odometry::windowTurn() const {
+  int oldest = -1;
+  for (int i = 0; i < map_.keyframeCapacity(); ++i) {
+    const Keyframe& k = map_.keyframe(i);
+    if (k.alive && k.in_backend && (oldest < 0 || k.id < map_.keyframe(oldest).id)) oldest = i;
+  }
+  double turn = 0;
+  for (int i = 0; oldest >= 0 && i < map_.keyframeCapacity(); ++i) {
+    const Keyframe& k = map_.keyframe(i);
+    if (!k.alive || !k.in_backend) continue;
+    const double c = 0.5 * ((map_.keyframe(oldest).T_w_b.R.transpose() * k.T_w_b.R).trace() - 1.0);
+    turn = std::max(turn, std::acos(std::clamp(c, -1.0, 1.0)));
+  }
+  return turn;
+}
+
 void Odometry::estimateScale() {
   if (!scale_free_start_ || !scale_estimator_) return;
   // Before convergence at every keyframe, from a coarse search (the unit may be far off); afterwards once per
   // window, from the map as it is: the check costs less.
   ++keyframes_since_scale_;
   if (scale_converged_ && keyframes_since_scale_ < options_.window_keyframes) return;
+  // The lever arms tell the scale only while the window turns: a window that turned less than this is not
+  // searched (its estimate comes back with a sigma of tens or thousands of percent, after costing the tracking
+  // thread most of a frame: a rig whose scale never converges would pay it at every keyframe).
+  constexpr double kMinWindowTurnRad = 2.0 * M_PI / 180.0;
+  if (windowTurn() < kMinWindowTurnRad) return;
   const int new_keyframes = keyframes_since_scale_;
   keyframes_since_scale_ = 0;
   const ScaleEstimate e = scale_estimator_->estimate(map_, scale_converged_ ? 1.0 : options_.scale_search_ratio);

@@ -102,6 +102,7 @@ class Odometry {
   // rescales the map when the combined estimate is certain (the first time: the scale has converged) or
   // significantly off.
   void estimateScale();
+  double windowTurn() const;  // largest rotation (rad) of a back-end window keyframe from the window's oldest
   int searchNewestKeyframeByDescriptor(const FrameFeatures& frame);
   void useExtrinsic(int cam, const SE3& T_b_c);  // in everything that tracks and maps
 
