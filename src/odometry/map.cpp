@@ -105,6 +105,15 @@ int Map::oldestKeyframe() const {
   return best;
 }
 
+int Map::oldestWindowKeyframe() const {
+  int best = -1;
+  for (int i = 0; i < static_cast<int>(keyframes_.size()); ++i) {
+    const Keyframe& k = keyframes_[i];
+    if (k.alive && k.in_backend && (best < 0 || k.id < keyframes_[best].id)) best = i;
+  }
+  return best;
+}
+
 int Map::newestKeyframe() const {
   int best = -1;
   for (int i = 0; i < static_cast<int>(keyframes_.size()); ++i) {

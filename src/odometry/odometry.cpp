@@ -208,11 +208,7 @@ void Odometry::finishKeyframe(int slot) {
 }
 
 double Odometry::windowTurn() const {
-  int oldest = -1;
-  for (int i = 0; i < map_.keyframeCapacity(); ++i) {
-    const Keyframe& k = map_.keyframe(i);
-    if (k.alive && k.in_backend && (oldest < 0 || k.id < map_.keyframe(oldest).id)) oldest = i;
-  }
+  const int oldest = map_.oldestWindowKeyframe();
   double turn = 0;
   for (int i = 0; oldest >= 0 && i < map_.keyframeCapacity(); ++i) {
     const Keyframe& k = map_.keyframe(i);

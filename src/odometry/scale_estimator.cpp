@@ -159,16 +159,15 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   // The window's keyframes; the oldest is the centre (the back-end holds it fixed).
   kf_slot_of_.assign(map.keyframeCapacity(), -1);  // sized once: the map's capacity does not change
   nk_ = 0;
-  int oldest = -1;
   for (int i = 0; i < map.keyframeCapacity(); ++i) {
     const Keyframe& k = map.keyframe(i);
     if (!k.alive || !k.in_backend) continue;
     if (nk_ >= kMaxKeyframes) return out;
     kf_slot_of_[i] = nk_++;
-    if (oldest < 0 || k.id < map.keyframe(oldest).id) oldest = i;
   }
   out.keyframes = nk_;
   if (nk_ < 3) return out;
+  const int oldest = map.oldestWindowKeyframe();
   out.center = map.keyframe(oldest).T_w_b.t;
   oldest_ = kf_slot_of_[oldest];
   for (int i = 0; i < map.keyframeCapacity(); ++i) {

@@ -84,7 +84,8 @@ class MultiViewMatcher {
   void finishFrame(FrameFeatures& frame);
   // finishFrame() in steps, for callers that run the subpixel alignment on their threads: mergeFrame();
   // alignTracks() (which also triangulates the tracks it aligned) for every task below alignTaskCount() (0 when
-  // the alignment is off or has no images), in any order and on any threads, each task once; emitTracks(). The result is finishFrame()'s, whatever the threads.
+  // the alignment is off or has no images), in any order and on any threads, each task once; emitTracks(). The
+  // result is finishFrame()'s, whatever the threads.
   void mergeFrame(FrameFeatures& frame);
   int alignTaskCount() const;
   void alignTracks(const FrameFeatures& frame, int task);

@@ -77,6 +77,7 @@ class Map {
   int keyframeCapacity() const { return static_cast<int>(keyframes_.size()); }
   int liveKeyframes() const;
   int oldestKeyframe() const;  // slot, -1 when none
+  int oldestWindowKeyframe() const;  // slot of the oldest keyframe in the back-end's window, -1 when none
   int newestKeyframe() const;
 
   // Links keypoint (cam, kp) of keyframe `kf` to landmark `lm`. When the landmark's observation list
