@@ -1,5 +1,5 @@
-// MultiViewMatcher's subpixel alignment of the partners of every track to its reference keypoint (the opt-in
-// multiview: align_subpixel). It runs between mergeFrame() and emitTracks(), in tasks of consecutive tracks
+// MultiViewMatcher's subpixel alignment of the partners of every track to its reference keypoint (multiview:
+// align_subpixel, on by default). It runs between mergeFrame() and emitTracks(), in tasks of consecutive tracks
 // that the caller may spread over threads: a track's alignment reads only the frame (keypoints, bearings,
 // images) and writes only its own members, counters and observations, so the result does not depend on which
 // thread aligned which task, nor in which order.

@@ -6,11 +6,13 @@
 //                                   extraction and multi-view milliseconds (extract_ms: ORB with the pairwise
 //                                   matching that runs on the workers as soon as a pair's cameras are done;
 //                                   match_ms: the merge into tracks and the triangulation)
-//   FrontEnd5Cam/mcslam             the whole front-end of the 5 overlapping cameras on 2 threads
+//   FrontEnd5Cam/mcslam             the whole front-end of the 5 overlapping cameras on 2 threads, the subpixel
+//                                   alignment off (what the anchor's matcher does too)
 //   FrontEnd5Cam/cv_orb             anchor: cv::ORB per camera (2 threads), then the same multi-view matcher with
 //                                   its cameras and pairs on 2 threads (extract_ms: ORB only)
-//   FrontEnd5CamAligned/mcslam      FrontEnd5Cam/mcslam with the subpixel alignment of multi-view partners on
-//                                   (multiview: align_subpixel: true; counters aligned, disagreeing: partners per frame)
+//   FrontEnd5CamAligned/mcslam      the default front-end: FrontEnd5Cam/mcslam with the subpixel alignment of
+//                                   multi-view partners on (multiview: align_subpixel; counters aligned,
+//                                   disagreeing: partners per frame)
 //   FrontEnd5CamAligned/off         anchor: the same front-end and input with the alignment off
 // Every case also reports process_cpu_ms: the CPU of all threads per rig frame (the CPU column is the main thread's
 // alone, and work moved onto the workers leaves it).
