@@ -117,6 +117,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   if (result == TrackResult::Failed) {
     ++stats_.lost;
     ++lost_frames_;
+    spdlog::trace("odometry: frame {}: lost ({} inliers; {} frames in a row)", frame_index, inliers, lost_frames_);
     // Carry on with the motion model so the trajectory stays continuous, and rebuild the map from
     // there when the loss lasts.
     T_w_last_ = have_velocity_ ? T_w_last_ * velocity_ : T_w_last_;
@@ -153,7 +154,8 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
     const auto map_start = Clock::now();
     const int slot = mapper_->insertKeyframe(frame, &matches_, T_w_b, frame_index);
     if (slot >= 0) {
-      mapper_->triangulateWithPrevious(slot);
+      const int created = mapper_->triangulateWithPrevious(slot);
+      spdlog::trace("odometry: frame {}: keyframe, {} inliers, {} new landmarks", frame_index, inliers, created);
       timing_.mapping_ms = msSince(map_start);
       const auto be_start = Clock::now();
       if (mapper_->beginOptimize(slot)) pending_keyframe_ = slot;
@@ -170,6 +172,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
     }
   }
   rememberTracked(frame, frame_index);
+  if (!out.is_keyframe) spdlog::trace("odometry: frame {}: {} inliers", frame_index, inliers);
   out.T_w_b = T_w_last_;
   out.state = TrackingState::Tracking;
   out.valid = true;
@@ -389,6 +392,7 @@ Odometry::TrackResult Odometry::track(const FrameFeatures& frame, uint64_t frame
     }
     SE3 candidate = predicted;
     const int n = found >= options_.min_matches_for_pose ? poseFromMatches(frame, predicted, true, candidate) : 0;
+    spdlog::trace("odometry: frame {}: coarse attempt {}: {} matches, {} inliers", frame_index, attempt, found, n);
     if (n > inliers) {
       inliers = n;
       coarse = candidate;

@@ -84,7 +84,8 @@ int main(int argc, char** argv) {
   app.add_option("--frames", max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", quiet, "No progress bar");
   app.add_option("--log-level", log_level, "Log of the pipeline's events (debug: also each scale estimate of a rig "
-                                           "without overlap)")
+                                           "without overlap; trace: also every frame's tracking attempts, inliers, "
+                                           "keyframes and new landmarks)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.add_flag("--overlap,!--no-overlap", overlap,
                "Run the front-end of the next frame while the odometry works on this one (the default; same output). "
