@@ -244,9 +244,9 @@ void Odometry::estimateScale() {
   const double x = scale_filter_->correction(), sigma = scale_filter_->sigma();
   stats_.combined_scale_sigma = sigma;
   // One line per estimate, for studies against ground truth (mcslam-run --log-level debug).
-  spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks), combined "
-                "{:.4f} sigma {:.4f}", frame_index_, e.scale, e.relative_sigma, e.keyframes, e.landmarks, std::exp(x),
-                sigma);
+  spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks, chi2/dof "
+                "{:.2f}), combined {:.4f} sigma {:.4f}", frame_index_, e.scale, e.relative_sigma, e.keyframes,
+                e.landmarks, e.reduced_chi2, std::exp(x), sigma);
   // A correction 3 sigma away from 1 is applied at any time: before convergence it brings the arbitrary unit near
   // the metric one (the windows' Gauss-Newton then starts in the basin; a unit 8x off left most windows without
   // an estimate), the poses staying flagged unscaled until the combined sigma reaches the bound.

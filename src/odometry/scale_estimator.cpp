@@ -266,7 +266,8 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   // window's minimum: its curvature says nothing about the scale.
   if (!(chi2 <= first_chi2) || !(last_u_step * last_u_step <= scale_variance_)) return out;
   const double dof = std::max(1.0, 2.0 * residuals - 3.0 * nl_ - 6.0 * (nk_ - 1));
-  const double reduced = std::max(1.0, chi2 / dof);
+  out.reduced_chi2 = chi2 / dof;
+  const double reduced = std::max(1.0, out.reduced_chi2);
   const double variance = scale_variance_ * reduced;
   if (!(variance > 0)) return out;
   out.scale = scaleOfPoses() / scale_before;

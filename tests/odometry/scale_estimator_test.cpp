@@ -70,11 +70,13 @@ TEST(ScaleEstimator, FindsTheMetricScaleOfATurningWindow) {
     buildWindow(rig, map, 60.0, map_scale, 0.5);
     ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 1.2f, 8);
     const ScaleEstimate e = est.estimate(map, 30.0);
-    std::printf("map scale %.2f: estimate %.4f (expected %.4f), sigma %.4f, %d landmarks\n", map_scale, e.scale,
-                1.0 / map_scale, e.relative_sigma, e.landmarks);
+    std::printf("map scale %.2f: estimate %.4f (expected %.4f), sigma %.4f, %d landmarks, chi2/dof %.3f\n",
+                map_scale, e.scale, 1.0 / map_scale, e.relative_sigma, e.landmarks, e.reduced_chi2);
     ASSERT_TRUE(e.ok);
     EXPECT_LT(e.relative_sigma, 0.05);
     EXPECT_NEAR(e.scale * map_scale, 1.0, 3.0 * e.relative_sigma);
+    // At the minimum the residuals are the noise: 0.5 px against the octave's 1 px sigma, chi2/dof 0.25.
+    EXPECT_NEAR(e.reduced_chi2, 0.25, 0.04);
   }
 }
 

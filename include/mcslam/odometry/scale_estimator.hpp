@@ -32,6 +32,9 @@ struct ScaleEstimate {
   int keyframes = 0;
   int landmarks = 0;
   int observations = 0;
+  // chi2 per degree of freedom at the minimum, in the octaves' pixel sigmas: how far the window's residuals are
+  // from the noise the sigma assumes (the sigma is inflated by it when above 1).
+  double reduced_chi2 = 0;
 };
 
 class ScaleEstimator {
