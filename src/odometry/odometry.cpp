@@ -57,7 +57,7 @@ Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_featu
   if (cams > 1) {
     const int window_obs = (options.window_keyframes + 1) * cams * max_features_per_camera;
     scale_estimator_ = std::make_unique<ScaleEstimator>(rig_, std::min(options.max_landmarks, window_obs), window_obs,
-                                                        options.scale_factor, options.levels);
+                                                        map_.keyframeCapacity(), options.scale_factor, options.levels);
     scale_filter_ = std::make_unique<ScaleFilter>();
   }
   observations_.resize(static_cast<std::size_t>(cams) * max_features_per_camera);

@@ -16,9 +16,10 @@ constexpr double kMissingSigmas = 10.0;
 constexpr int kGaussNewtonSteps = 4;
 }  // namespace
 
-ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, float octave_scale_factor,
-                               int levels)
+ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
+                               float octave_scale_factor, int levels)
     : rig_(rig) {
+  kf_slot_of_.resize(max_keyframes);
   for (int o = 0; o < std::max(levels, 1); ++o) octave_sigma_.push_back(std::pow(octave_scale_factor, o));
   kf_T_.resize(kMaxKeyframes);
   T_c_b_.resize(rig.size());
@@ -157,7 +158,8 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   ScaleEstimate out;
   for (int c = 0; c < rig_.size(); ++c) T_c_b_[c] = rig_.T_b_c(c).inverse();
   // The window's keyframes; the oldest is the centre (the back-end holds it fixed).
-  kf_slot_of_.assign(map.keyframeCapacity(), -1);  // sized once: the map's capacity does not change
+  if (map.keyframeCapacity() > static_cast<int>(kf_slot_of_.size())) return out;  // not the map it was sized for
+  std::fill(kf_slot_of_.begin(), kf_slot_of_.end(), -1);
   nk_ = 0;
   for (int i = 0; i < map.keyframeCapacity(); ++i) {
     const Keyframe& k = map.keyframe(i);

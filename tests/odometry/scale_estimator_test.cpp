@@ -4,6 +4,7 @@
 #include <random>
 
 #include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/odometry/scale_estimator.hpp"
 #include "synthetic_sequence.hpp"
 #include "test_support.hpp"
@@ -68,7 +69,7 @@ TEST(ScaleEstimator, FindsTheMetricScaleOfATurningWindow) {
   for (double map_scale : {0.4, 1.0, 2.5}) {
     Map map(rig, 2000, 14, 4000);
     buildWindow(rig, map, 60.0, map_scale, 0.5);
-    ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 1.2f, 8);
+    ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 14, 1.2f, 8);
     const ScaleEstimate e = est.estimate(map, 30.0);
     std::printf("map scale %.2f: estimate %.4f (expected %.4f), sigma %.4f, %d landmarks, chi2/dof %.3f\n",
                 map_scale, e.scale, 1.0 / map_scale, e.relative_sigma, e.landmarks, e.reduced_chi2);
@@ -87,8 +88,34 @@ TEST(ScaleEstimator, StraightWindowLeavesTheScaleOpen) {
   const Rig rig = test::nonOverlappingRig3();
   Map map(rig, 2000, 14, 4000);
   buildWindow(rig, map, 0.0, 2.5, 0.5);
-  ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 1.2f, 8);
+  ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 14, 1.2f, 8);
   const ScaleEstimate e = est.estimate(map, 30.0);
   std::printf("straight: ok %d estimate %.4f sigma %.4f\n", e.ok, e.scale, e.relative_sigma);
   EXPECT_TRUE(!e.ok || e.relative_sigma > 1.0);
+}
+
+// Its scratch is sized at construction (the map's keyframe capacity included): no estimate allocates, the first
+// one and one over a smaller window included. (The first estimate once sized the keyframe table: a rig whose
+// first turn came after the warm-up allocated then, and again after every re-initialization.)
+TEST(ScaleEstimator, EstimatesAllocateNothing) {
+  if (!alloc::available()) GTEST_SKIP() << "allocation counting is not linked";
+  const Rig rig = test::nonOverlappingRig3();
+  Map map(rig, 2000, 14, 4000);
+  buildWindow(rig, map, 60.0, 2.5, 0.5);
+  ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 14, 1.2f, 8);
+  alloc::ThreadScope scope;
+  const ScaleEstimate full = est.estimate(map, 30.0);
+  int left = 0;
+  for (int i = 0; i < map.keyframeCapacity() && left < 3; ++i) {  // three keyframes leave the window
+    Keyframe& kf = map.keyframe(i);
+    if (kf.alive && kf.in_backend && i != map.oldestWindowKeyframe()) {
+      kf.in_backend = false;
+      ++left;
+    }
+  }
+  const ScaleEstimate smaller = est.estimate(map, 1.0);
+  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_TRUE(full.ok);
+  EXPECT_EQ(full.keyframes, 8);
+  EXPECT_EQ(smaller.keyframes, 5);
 }

@@ -39,8 +39,10 @@ struct ScaleEstimate {
 
 class ScaleEstimator {
  public:
-  // max_observations: observations of window landmarks by window keyframes (window * cameras * features).
-  ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, float octave_scale_factor, int levels);
+  // max_observations: observations of window landmarks by window keyframes (window * cameras * features);
+  // max_keyframes: the map's keyframe capacity. All scratch is allocated here: estimate() allocates nothing.
+  ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
+                 float octave_scale_factor, int levels);
 
   // Uses the keyframes with in_backend set and the landmarks two of them observe. `max_ratio` bounds the
   // coarse search: s in [1 / max_ratio, max_ratio]; at most 1, Gauss-Newton starts from the map as it is.
