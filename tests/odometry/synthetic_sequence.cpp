@@ -29,14 +29,45 @@ Rig nonOverlappingRig3() {
 
 namespace {
 // World: z up. Body: camera-like (x right, y down, z forward), moving in the horizontal plane.
-SE3 bodyPose(double s, double radius) {
-  // A loop with a wobble: the heading changes at varying rates (up to ~40 deg/s at 1 m/s).
-  const double a = s / radius;
+// A loop with a wobble: the heading changes at varying rates (up to ~40 deg/s at 1 m/s).
+Vec3 circlePointAt(double a, double radius) {
   const double r = radius * (1.0 + 0.25 * std::sin(3.0 * a));
-  const Vec3 p(r * std::cos(a), r * std::sin(a), 0.6);
-  const double a2 = a + 1e-3;
-  const double r2 = radius * (1.0 + 0.25 * std::sin(3.0 * a2));
-  const Vec3 q(r2 * std::cos(a2), r2 * std::sin(a2), 0.6);
+  return Vec3(r * std::cos(a), r * std::sin(a), 0.6);
+}
+
+// A rounded rectangle, counter-clockwise from the middle of its lower side's straight.
+Vec3 rectanglePoint(double s, double side_x, double side_y) {
+  constexpr double kCorner = 1.2;
+  const double straight[2] = {side_x - 2 * kCorner, side_y - 2 * kCorner}, arc = 0.5 * M_PI * kCorner;
+  s = std::fmod(s, 2 * (straight[0] + straight[1]) + 4 * arc);
+  Vec3 start(-0.5 * side_x + kCorner, -0.5 * side_y, 0.6);
+  double heading = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Vec3 along(std::cos(heading), std::sin(heading), 0), left(-std::sin(heading), std::cos(heading), 0);
+    if (s < straight[k % 2]) return start + s * along;
+    s -= straight[k % 2];
+    const Vec3 centre = start + straight[k % 2] * along + kCorner * left;
+    if (s < arc) {
+      const double a = s / kCorner;
+      return centre - kCorner * std::cos(a) * left + kCorner * std::sin(a) * along;
+    }
+    s -= arc;
+    start = centre + kCorner * along;
+    heading += 0.5 * M_PI;
+  }
+  return start;
+}
+
+SE3 bodyPose(double s, const SyntheticSequenceOptions& o) {
+  Vec3 p, q;  // here and a step ahead
+  if (o.rounded_rectangle) {
+    p = rectanglePoint(s, o.rectangle_x_m, o.rectangle_y_m);
+    q = rectanglePoint(s + 1e-3, o.rectangle_x_m, o.rectangle_y_m);
+  } else {
+    const double a = s / o.radius_m;
+    p = circlePointAt(a, o.radius_m);
+    q = circlePointAt(a + 1e-3, o.radius_m);
+  }
   const Vec3 forward = (q - p).normalized();
   const Vec3 down(0, 0, -1);
   const Vec3 right = down.cross(forward);  // x = y cross z
@@ -84,7 +115,7 @@ SyntheticSequence::SyntheticSequence(const Rig& rig, const SyntheticSequenceOpti
   for (int i = 0; i < o.frames; ++i) {
     StampedPose sp;
     sp.t = static_cast<Timestamp>(i * 1e9 / o.rate_hz);
-    sp.T_w_b = bodyPose(i * length_per_frame, o.radius_m);
+    sp.T_w_b = bodyPose(i * length_per_frame, o);
     truth_.push_back(sp);
   }
 }

@@ -20,7 +20,11 @@ Rig nonOverlappingRig3();
 struct SyntheticSequenceOptions {
   int frames = 200;
   double rate_hz = 10.0;
-  double radius_m = 4.0;         // loop radius (a circle with a wobble)
+  double radius_m = 4.0;         // loop radius (a circle with a wobble); the world's wall stands around it
+  // Instead of the circle: a rounded rectangle of straights and quarter-turn corners, as rooms and corridors
+  // make a ground robot drive (corner radius 1.2 m: 48 deg/s at 1 m/s). Sides in metres, centred on the loop.
+  bool rounded_rectangle = false;
+  double rectangle_x_m = 12.0, rectangle_y_m = 8.0;
   double speed_mps = 1.0;
   double noise_px = 0.5;
   int points = 15000;
