@@ -147,6 +147,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   }
   velocity_ = T_w_last_.inverse() * T_w_b;
   have_velocity_ = true;
+  rotation_travelled_ += std::acos(std::clamp(0.5 * (velocity_.R.trace() - 1.0), -1.0, 1.0));
   T_w_last_ = T_w_b;
   timing_.tracking_ms = msSince(start);
 
@@ -240,17 +241,21 @@ void Odometry::estimateScale() {
   if (!e.ok) return;
   stats_.last_scale = e.scale;
   stats_.last_scale_sigma = e.relative_sigma;
-  if (!scale_filter_->add(std::log(e.scale), e.relative_sigma, e.keyframes, new_keyframes)) return;  // an outlier
+  if (!scale_filter_->add(std::log(e.scale), e.relative_sigma, e.keyframes, new_keyframes, rotation_travelled_)) {
+    return;  // an outlier
+  }
   const double x = scale_filter_->correction(), sigma = scale_filter_->sigma();
   stats_.combined_scale_sigma = sigma;
   // One line per estimate, for studies against ground truth (mcslam-run --log-level debug).
   spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks, chi2/dof "
-                "{:.2f}), combined {:.4f} sigma {:.4f}", frame_index_, e.scale, e.relative_sigma, e.keyframes,
-                e.landmarks, e.reduced_chi2, std::exp(x), sigma);
+                "{:.2f}), combined {:.4f} sigma {:.4f} over {:.0f} deg", frame_index_, e.scale, e.relative_sigma,
+                e.keyframes, e.landmarks, e.reduced_chi2, std::exp(x), sigma,
+                scale_filter_->rotationSpan() * 180.0 / M_PI);
   // A correction 3 sigma away from 1 is applied at any time: before convergence it brings the arbitrary unit near
   // the metric one (the windows' Gauss-Newton then starts in the basin; a unit 8x off left most windows without
   // an estimate), the poses staying flagged unscaled until the combined sigma reaches the bound.
-  const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma;
+  const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma &&
+                         scale_filter_->rotationSpan() >= options_.scale_min_rotation_deg * M_PI / 180.0;
   if (!converges && !(std::abs(x) > 3.0 * sigma)) return;
   // The whole live map, the window and the motion model take the new unit at once.
   const double s = std::exp(x);

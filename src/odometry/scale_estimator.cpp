@@ -278,7 +278,7 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   return out;
 }
 
-bool ScaleFilter::add(double log_scale, double sigma, int window_keyframes, int new_keyframes) {
+bool ScaleFilter::add(double log_scale, double sigma, int window_keyframes, int new_keyframes, double rotation) {
   const int window = std::max(1, window_keyframes);
   const double r = sigma * sigma * window / std::clamp(new_keyframes, 1, window);
   if (info_ > 0 && (log_scale - x_) * (log_scale - x_) > 9.0 * (r + 1.0 / info_)) {
@@ -287,6 +287,8 @@ bool ScaleFilter::add(double log_scale, double sigma, int window_keyframes, int 
     info_ = 0;
   }
   rejected_ = 0;
+  if (info_ == 0) first_rotation_ = rotation;
+  last_rotation_ = rotation;
   x_ = (x_ * info_ + log_scale / r) / (info_ + 1.0 / r);
   info_ += 1.0 / r;
   return true;

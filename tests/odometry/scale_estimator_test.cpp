@@ -119,3 +119,22 @@ TEST(ScaleEstimator, EstimatesAllocateNothing) {
   EXPECT_EQ(full.keyframes, 8);
   EXPECT_EQ(smaller.keyframes, 5);
 }
+
+// The filter says over how much rotation its estimates were gathered, from the first one it kept since it
+// (re)started: the odometry declares a scale metric only when that spans two corners' worth.
+TEST(ScaleFilter, RotationSpanCountsFromTheFirstEstimateKept) {
+  ScaleFilter f;
+  EXPECT_EQ(f.rotationSpan(), 0.0);
+  EXPECT_TRUE(f.add(0.0, 0.02, 8, 8, 1.0));
+  EXPECT_TRUE(f.add(0.01, 0.02, 8, 4, 2.5));
+  EXPECT_DOUBLE_EQ(f.rotationSpan(), 1.5);
+  // Three windows in a row far off: the map's scale moved, the combination restarts from the third.
+  EXPECT_FALSE(f.add(1.0, 0.02, 8, 1, 3.0));
+  EXPECT_FALSE(f.add(1.0, 0.02, 8, 1, 3.2));
+  EXPECT_TRUE(f.add(1.0, 0.02, 8, 1, 3.4));
+  EXPECT_DOUBLE_EQ(f.rotationSpan(), 0.0);
+  EXPECT_TRUE(f.add(1.0, 0.02, 8, 1, 4.0));
+  EXPECT_NEAR(f.rotationSpan(), 0.6, 1e-12);
+  f.reset();
+  EXPECT_EQ(f.rotationSpan(), 0.0);
+}

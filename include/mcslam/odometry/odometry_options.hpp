@@ -40,6 +40,10 @@ struct OdometryOptions {
   // factor either way of the current unit.
   double scale_max_sigma = 0.05 / 3.0;
   double scale_search_ratio = 30.0;
+  // ... and when the estimates combined were gathered over at least this much rotation of the rig: the windows
+  // of one turn share their scene and the map's history, and agreed on a unit 5x off in 2 of 7 runs of the
+  // 10 cm rig (one 90-degree corner, BENCHMARKS.md); two corners' worth must confirm it.
+  double scale_min_rotation_deg = 180.0;
 
   // Mapping.
   // Multi-view points become landmarks below this relative depth sigma: the same bar as points triangulated

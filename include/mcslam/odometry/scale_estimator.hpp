@@ -90,24 +90,29 @@ class ScaleEstimator {
 // independent: an estimate counts as much as the keyframes new to it (its variance times window keyframes
 // over new keyframes). An estimate that disagrees with the combined one by more than 3 sigma is
 // dropped; when the windows of several keyframes in a row disagree, the map's scale has drifted (a straight
-// stretch hides it) and the combination restarts from the latest.
+// stretch hides it) and the combination restarts from the latest. Windows of one turn also share their
+// scene and the map's history, beyond the keyframes they share: rotationSpan() says over how much rotation of
+// the rig (radians travelled, `rotation` of add()) the combined estimates were gathered.
 class ScaleFilter {
  public:
   void reset() {
     x_ = 0;
     info_ = 0;
     rejected_ = 0;
+    first_rotation_ = last_rotation_ = 0;
   }
-  // False when the estimate was dropped as an outlier.
-  bool add(double log_scale, double sigma, int window_keyframes, int new_keyframes);
+  // False when the estimate was dropped as an outlier. `rotation`: the rig's rotation travelled so far.
+  bool add(double log_scale, double sigma, int window_keyframes, int new_keyframes, double rotation = 0);
   double correction() const { return x_; }  // log of the factor the map needs
   double sigma() const { return info_ > 0 ? 1.0 / std::sqrt(info_) : INFINITY; }
+  double rotationSpan() const { return last_rotation_ - first_rotation_; }
   void applied() { x_ = 0; }  // the map took the correction: what is known of its scale stays
 
  private:
   static constexpr int kRestartAfter = 3;
   double x_ = 0, info_ = 0;
   int rejected_ = 0;
+  double first_rotation_ = 0, last_rotation_ = 0;
 };
 
 }  // namespace mcslam
