@@ -147,7 +147,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   }
   velocity_ = T_w_last_.inverse() * T_w_b;
   have_velocity_ = true;
-  rotation_travelled_ += std::acos(std::clamp(0.5 * (velocity_.R.trace() - 1.0), -1.0, 1.0));
+  rotation_travelled_ += rotationAngle(T_w_last_.R, T_w_b.R);
   T_w_last_ = T_w_b;
   timing_.tracking_ms = msSince(start);
 
@@ -217,8 +217,7 @@ double Odometry::windowTurn() const {
   for (int i = 0; oldest >= 0 && i < map_.keyframeCapacity(); ++i) {
     const Keyframe& k = map_.keyframe(i);
     if (!k.alive || !k.in_backend) continue;
-    const double c = 0.5 * ((map_.keyframe(oldest).T_w_b.R.transpose() * k.T_w_b.R).trace() - 1.0);
-    turn = std::max(turn, std::acos(std::clamp(c, -1.0, 1.0)));
+    turn = std::max(turn, rotationAngle(map_.keyframe(oldest).T_w_b.R, k.T_w_b.R));
   }
   return turn;
 }
