@@ -45,28 +45,27 @@ def feature_counts(base, repeats):
     return [round(base * (0.95 + 0.1 * i / (repeats - 1))) for i in range(repeats)]
 
 
-def variant_config(bin_dir, dataset, cams, slam_config, features, path):
-    """The run's effective configuration (mcslam-run --print-config) with another feature capacity, written to
-    path; the configuration's other values stay as the user's file or the defaults give them for this rig."""
+# The feature capacity line of a printed configuration; its digits are what the repeats change.
+FEATURES_LINE = re.compile(r"(?m)^(\s*max_features_per_camera:\s*)(\d+)")
+
+
+def effective_config(bin_dir, dataset, cams, slam_config):
+    """The run's effective configuration (mcslam-run --print-config): the user's file or the defaults, for this
+    rig. The repeats write it back with only the feature capacity changed."""
     cmd = [os.path.join(bin_dir, "mcslam-run"), "--dataset", dataset, "--cameras", cams, "--print-config"]
     if slam_config:
         cmd += ["--config", slam_config]
-    text, n = re.subn(r"(?m)^(\s*max_features_per_camera:\s*)\d+", rf"\g<1>{features}", run(cmd))
+    text = run(cmd)
+    n = len(FEATURES_LINE.findall(text))
     if n != 1:
         sys.exit(f"camera_study: {' '.join(cmd)}: expected one max_features_per_camera line, found {n}")
+    return text
+
+
+def write_variant(config_text, features, path):
     with open(path, "w") as f:
-        f.write(text)
+        f.write(FEATURES_LINE.sub(rf"\g<1>{features}", config_text))
     return path
-
-
-def base_features(bin_dir, dataset, cams, slam_config):
-    cmd = [os.path.join(bin_dir, "mcslam-run"), "--dataset", dataset, "--cameras", cams, "--print-config"]
-    if slam_config:
-        cmd += ["--config", slam_config]
-    m = re.search(r"(?m)^\s*max_features_per_camera:\s*(\d+)", run(cmd))
-    if not m:
-        sys.exit(f"camera_study: {' '.join(cmd)} printed no max_features_per_camera")
-    return int(m.group(1))
 
 
 def evaluate(bin_dir, dataset, traj, align, plot=None):
@@ -76,16 +75,16 @@ def evaluate(bin_dir, dataset, traj, align, plot=None):
     return json.loads(run(cmd))
 
 
-def run_once(args, dataset, seq, name, cams, align, features, repeats):
-    """One mcslam-run and its evaluation: a row of the study."""
+def run_once(args, dataset, seq, name, cams, align, features, repeats, config_text):
+    """One mcslam-run and its evaluation: a row of the study. config_text: the effective configuration, for
+    the repeats (None for a single run)."""
     tag = f"{seq}_{name}".replace(" ", "_").replace("/", "_") + (f"_f{features}" if repeats > 1 else "")
     traj = os.path.join(args.out, tag + ".tum")
     stats_path = os.path.join(args.out, tag + "_stats.json")
     cmd = [os.path.join(args.bin, "mcslam-run"), "--dataset", dataset, "--cameras", cams, "--out", traj,
            "--stats", stats_path, "--quiet"]
     if repeats > 1:
-        cmd += ["--config", variant_config(args.bin, dataset, cams, args.slam_config, features,
-                                           os.path.join(args.out, tag + ".yaml"))]
+        cmd += ["--config", write_variant(config_text, features, os.path.join(args.out, tag + ".yaml"))]
     elif args.slam_config:
         cmd += ["--config", args.slam_config]
     print(f"camera_study: {seq} / {name} (cameras {cams}"
@@ -165,8 +164,9 @@ def main():
     for dataset in args.dataset:
         seq = os.path.basename(os.path.normpath(dataset))
         for name, cams, align in configs:
-            base = base_features(args.bin, dataset, cams, args.slam_config) if args.repeats > 1 else None
-            group = [run_once(args, dataset, seq, name, cams, align, features, args.repeats)
+            text = effective_config(args.bin, dataset, cams, args.slam_config) if args.repeats > 1 else None
+            base = int(FEATURES_LINE.search(text).group(2)) if text else None
+            group = [run_once(args, dataset, seq, name, cams, align, features, args.repeats, text)
                      for features in feature_counts(base, args.repeats)]
             rows += group
             groups.append(group)
