@@ -102,7 +102,7 @@ class ScaleFilter {
     first_rotation_ = last_rotation_ = 0;
   }
   // False when the estimate was dropped as an outlier. `rotation`: the rig's rotation travelled so far.
-  bool add(double log_scale, double sigma, int window_keyframes, int new_keyframes, double rotation = 0);
+  bool add(double log_scale, double sigma, int window_keyframes, int new_keyframes, double rotation);
   double correction() const { return x_; }  // log of the factor the map needs
   double sigma() const { return info_ > 0 ? 1.0 / std::sqrt(info_) : INFINITY; }
   double rotationSpan() const { return last_rotation_ - first_rotation_; }
