@@ -63,6 +63,11 @@ bool buildSystem(const TriangulationObservation* obs, int n, const Vec3& p, Mat3
   return true;
 }
 
+bool depthKnown(const TriangulationResult& r, const TriangulationOptions& o) {
+  if (!(o.reference_inverse_depth > 0)) return r.relative_depth_sigma <= o.max_relative_depth_sigma;
+  return r.inverse_depth_sigma <= o.max_relative_depth_sigma * o.reference_inverse_depth && r.relative_depth_sigma <= 1.0;
+}
+
 }  // namespace
 
 TriangulationResult triangulate(const TriangulationObservation* obs, int n, const TriangulationOptions& options) {
@@ -122,6 +127,7 @@ TriangulationResult triangulate(const TriangulationObservation* obs, int n, cons
     const Vec3 u = ray / range;
     const double sigma = std::sqrt(std::max(0.0, u.dot(cov * u)));
     res.relative_depth_sigma = std::max(res.relative_depth_sigma, sigma / range);
+    res.inverse_depth_sigma = std::max(res.inverse_depth_sigma, sigma / (range * range));
     for (int j = i + 1; j < n; ++j) {
       const Vec3 rj = (p - obs[j].T_f_c.t).normalized();
       max_cos = std::min(max_cos, u.dot(rj));
@@ -130,7 +136,7 @@ TriangulationResult triangulate(const TriangulationObservation* obs, int n, cons
   res.max_parallax_deg = std::acos(std::clamp(max_cos, -1.0, 1.0)) * 180.0 / M_PI;
   if (max_err > options.max_reprojection_sigmas) res.status = TriangulationStatus::LargeReprojection;
   else if (res.max_parallax_deg < options.min_parallax_deg) res.status = TriangulationStatus::LowParallax;
-  else if (!(res.relative_depth_sigma <= options.max_relative_depth_sigma)) res.status = TriangulationStatus::Uncertain;
+  else if (!depthKnown(res, options)) res.status = TriangulationStatus::Uncertain;
   else res.status = TriangulationStatus::Ok;
   return res;
 }

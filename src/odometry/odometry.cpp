@@ -321,6 +321,7 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   // constrained it: the 33 cm rig's map shrank to a tenth on a straight stretch, the 10 cm rig lost track.
   // resetMap() lets it go with the window.
   if (!metric && rig_.size() > 1) mapper_->holdScale(true);
+  mapper_->setSceneReferencedPoints(!metric || rig_.size() == 1);
   keyframes_since_scale_ = 0;
   if (scale_filter_) scale_filter_->reset();
   ++stats_.initializations;

@@ -30,6 +30,9 @@ class LocalMapper {
 
   // New landmarks from keyframe `slot`'s unmatched keypoints and those of the previous keyframes.
   int triangulateWithPrevious(int slot);
+  // Whether the map's unit rests on the points triangulated across keyframes (one camera, a rig without overlap):
+  // then they are accepted on an unbiased rule (triangulateWithPrevious()).
+  void setSceneReferencedPoints(bool on) { scene_referenced_points_ = on; }
 
   // Runs the sliding-window optimization including keyframe `slot` and writes the results back into
   // the map. Returns false when the back-end is off or failed.
@@ -72,6 +75,8 @@ class LocalMapper {
   void finishTouched();
   void backendRemoveLandmark(int lm);
   int keyframeSlotOfId(int64_t id) const;
+  // Median inverse distance (1/m) from keyframe `slot` to the landmarks it observes; 0 with too few of them.
+  double sceneInverseDepth(int slot);
 
   const Rig& rig_;       // the odometry's: its extrinsics follow the estimates
   Rig calibration_;      // the back-end's prior, also for a new window after a reset
@@ -102,6 +107,8 @@ class LocalMapper {
   std::vector<Best> best_;
   EpipolarBandIndex band_index_;     // the old camera's free keypoints, by epipolar half-plane
   std::vector<double> gate_;         // per octave: sine distance to the epipolar plane allowed
+  bool scene_referenced_points_ = false;
+  std::vector<double> inverse_ranges_;  // scratch of sceneInverseDepth(): one per keypoint of a keyframe
   std::vector<TriangulationObservation> tri_obs_;
   std::vector<KeypointRef> tri_refs_;  // keyframe-tagged refs in tri_obs_ order (cam, index)
   std::vector<int32_t> tri_kf_;        // keyframe slot of each tri_obs_ entry

@@ -67,8 +67,9 @@ struct OdometryOptions {
   double extrinsic_sigma_rotation_deg = 1.0;
 
   OdometryOptions() {
-    // Points from different keyframes need the parallax of ORB-SLAM's rule (about 1 degree) and a depth
-    // known to 15%: the back-end refines them from there.
+    // Points from different keyframes need a depth known to 15% and the parallax of ORB-SLAM's rule (about 1
+    // degree); where the map's unit rests on them (one camera, no overlap), an inverse depth known to 15% of the
+    // scene's instead (LocalMapper::triangulateWithPrevious says why). The back-end refines them from there.
     new_points.max_relative_depth_sigma = 0.15;
     new_points.min_parallax_deg = 1.0;
   }
