@@ -272,7 +272,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
   // Where the map's unit rests on these points (scene_referenced_points_), they are judged by the uncertainty of
   // their inverse depth against the scene's, not of their depth against their own, and without a parallax bound
   // (TriangulationOptions::reference_inverse_depth): both selected the points that noise put nearer, and a
-  // one-camera map shrank at every corner (0.14x its first unit by the end of the rendered indoor loop). Where
+  // one-camera map shrank at every corner (to a tenth of its first unit by the end of the rendered indoor loop). Where
   // multi-view features give every frame its metres, the own bounds stay: they reject points whose depth is
   // imprecise, which tracking takes as exact (the scene bound made 5-frame spans of the first 50 frames of the
   // 5-camera sequence up to 8% long). A keyframe without a scene yet (initialization) uses the own bounds too.
