@@ -1,4 +1,5 @@
 #include "extrinsic_check.hpp"
+#include "median.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,11 +13,6 @@ namespace {
 // A camera is suspect when it holds fewer than this share of the inliers the other cameras hold (median):
 // a camera whose extrinsic is within the gate keeps a share of the same order as its neighbours'.
 constexpr double kCollapsedShare = 0.25;
-
-double medianOf(std::vector<double>& v, int n) {
-  std::nth_element(v.begin(), v.begin() + n / 2, v.begin() + n);
-  return v[n / 2];
-}
 
 }  // namespace
 

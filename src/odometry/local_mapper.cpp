@@ -1,6 +1,7 @@
 #include "mcslam/odometry/local_mapper.hpp"
 
 #include "backend_worker.hpp"
+#include "median.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -407,10 +408,7 @@ double LocalMapper::sceneInverseDepth(int slot) {
       if (range > 0) inverse_ranges_[n++] = 1.0 / range;
     }
   }
-  if (n < kMinLandmarks) return 0;
-  const auto mid = inverse_ranges_.begin() + n / 2;
-  std::nth_element(inverse_ranges_.begin(), mid, inverse_ranges_.begin() + n);
-  return *mid;
+  return n < kMinLandmarks ? 0.0 : medianOf(inverse_ranges_, n);
 }
 
 bool LocalMapper::optimize(int slot) {
