@@ -235,7 +235,13 @@ void Odometry::estimateScale() {
   if (windowTurn() < kMinWindowTurnRad) return;
   const int new_keyframes = keyframes_since_scale_;
   keyframes_since_scale_ = 0;
-  const ScaleEstimate e = scale_estimator_->estimate(map_, scale_converged_ ? 1.0 : options_.scale_search_ratio);
+  // The search range: the whole of it while the unit is arbitrary; within a factor 2 once the combined windows
+  // know it to 20% (the search re-fits the window at every factor it tries: the range is most of its cost).
+  constexpr double kKnownSigma = 0.2, kKnownRatio = 2.0;
+  const double ratio = scale_converged_ ? 1.0
+                       : scale_filter_->sigma() <= kKnownSigma ? std::min(kKnownRatio, options_.scale_search_ratio)
+                                                               : options_.scale_search_ratio;
+  const ScaleEstimate e = scale_estimator_->estimate(map_, ratio);
   ++stats_.scale_estimates;
   if (!e.ok) return;
   stats_.last_scale = e.scale;

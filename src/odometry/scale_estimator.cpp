@@ -13,7 +13,14 @@ namespace {
 // A ray that no longer projects costs as much as a residual of this many sigmas: large, but bounded, so
 // that the cost stays continuous enough to search.
 constexpr double kMissingSigmas = 10.0;
-constexpr int kGaussNewtonSteps = 4;
+constexpr int kGaussNewtonSteps = 6;
+// Levenberg-Marquardt damping (relative to the system's diagonal): a step that does not lower the cost is
+// retried with ten times more, up to the largest (then the window is at its minimum).
+constexpr double kMinDamping = 1e-6, kMaxDamping = 1e4;
+// The profile's spacing in s, and the steps that re-fit the window at each factor (from its neighbour's fit): the
+// profile only chooses the basin, the free refinement then finds the minimum in it.
+constexpr double kProfileRatio = 1.4;
+constexpr int kProfileSteps = 2;
 }  // namespace
 
 ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
@@ -22,19 +29,24 @@ ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observ
   kf_slot_of_.resize(max_keyframes);
   for (int o = 0; o < std::max(levels, 1); ++o) octave_sigma_.push_back(std::pow(octave_scale_factor, o));
   kf_T_.resize(kMaxKeyframes);
+  kf_before_.resize(kMaxKeyframes);
+  kf_start_.resize(kMaxKeyframes);
+  kf_best_.resize(kMaxKeyframes);
   T_c_b_.resize(rig.size());
   lm_p_.resize(max_landmarks);
+  lm_start_.resize(max_landmarks);
+  lm_best_.resize(max_landmarks);
   lm_first_.resize(static_cast<std::size_t>(max_landmarks) + 1);
   obs_.resize(max_observations);
 }
 
-double ScaleEstimator::landmarkCost(int l, double s, Vec3& p, bool refine, int* residuals) {
+double ScaleEstimator::landmarkCost(int l, Vec3& p, bool refine, int* residuals) {
   const int begin = lm_first_[l], end = lm_first_[l + 1];
   const double missing = loss_.rho(kMissingSigmas * kMissingSigmas);
   auto cameraPoint = [&](const Obs& o) {
     const SE3& T_b_c = rig_.T_b_c(o.cam);
     const SE3& T = kf_T_[o.kf];
-    return Vec3(T_b_c.R.transpose() * (T.R.transpose() * (p - s * T.t) - T_b_c.t));
+    return Vec3(T_b_c.R.transpose() * (T.R.transpose() * (p - T.t) - T_b_c.t));
   };
   for (int it = 0; it < (refine ? 2 : 0); ++it) {
     Mat3 H = Mat3::Zero();
@@ -70,13 +82,61 @@ double ScaleEstimator::landmarkCost(int l, double s, Vec3& p, bool refine, int* 
   return 0.5 * c;
 }
 
-double ScaleEstimator::cost(double s, int* residuals) {
+double ScaleEstimator::cost() {
   double c = 0;
   for (int l = 0; l < nl_; ++l) {
-    Vec3 p = s * lm_p_[l];
-    c += landmarkCost(l, s, p, true, residuals);
+    Vec3 p = lm_p_[l];
+    c += landmarkCost(l, p, true, nullptr);
   }
   return c;
+}
+
+void ScaleEstimator::scaleWindow(double s) {
+  for (int w = 0; w < nk_; ++w) kf_T_[w].t *= s;
+  for (int l = 0; l < nl_; ++l) lm_p_[l] *= s;
+}
+
+void ScaleEstimator::saveWindow(std::vector<SE3>& kf, std::vector<Vec3>& lm) const {
+  std::copy_n(kf_T_.begin(), nk_, kf.begin());
+  std::copy_n(lm_p_.begin(), nl_, lm.begin());
+}
+
+void ScaleEstimator::restoreWindow(const std::vector<SE3>& kf, const std::vector<Vec3>& lm) {
+  std::copy_n(kf.begin(), nk_, kf_T_.begin());
+  std::copy_n(lm.begin(), nl_, lm_p_.begin());
+}
+
+bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
+  c = cost();
+  u_step = 0;
+  double lambda = kMinDamping;
+  ReducedVec step;
+  for (int it = 0; it < steps; ++it) {
+    double chi2 = 0;
+    int residuals = 0;
+    if (!reducedSystem(chi2, residuals)) return false;
+    std::copy_n(kf_T_.begin(), nk_, kf_before_.begin());
+    bool taken = false;
+    for (; !taken && lambda <= kMaxDamping; lambda *= 10.0) {
+      if (!dampedStep(lambda, step)) continue;
+      for (int w = 0; w < nk_; ++w) {
+        const int f = freeIndex(w);
+        if (f >= 0) kf_T_[w] = kf_before_[w] * SE3::exp(step.segment<6>(6 * f));
+      }
+      const double trial = cost();
+      if (trial < c) {
+        c = trial;
+        u_step = g_.dot(step);
+        taken = true;
+      }
+    }
+    if (!taken) {  // no descent even along the gradient: the minimum
+      std::copy_n(kf_before_.begin(), nk_, kf_T_.begin());
+      break;
+    }
+    lambda = std::max(kMinDamping, lambda / 100.0);  // the loop's last *10 included
+  }
+  return true;
 }
 
 double ScaleEstimator::scaleOfPoses() const {
@@ -85,7 +145,7 @@ double ScaleEstimator::scaleOfPoses() const {
   return sum;
 }
 
-bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residuals) {
+bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
   const int dim = 6 * (nk_ - 1);
   S_.setZero(dim, dim);
   b_.setZero(dim);
@@ -97,7 +157,7 @@ bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residual
   for (int w = 0; w < nk_; ++w) T_b_w[w] = kf_T_[w].inverse();
   for (int l = 0; l < nl_; ++l) {
     Vec3 p = lm_p_[l];
-    landmarkCost(l, 1.0, p, true, nullptr);  // the landmark's best position for these poses
+    landmarkCost(l, p, true, nullptr);  // the landmark's best position for these poses
     lm_p_[l] = p;
     Mat3 Hll = Mat3::Zero();
     Vec3 bl = Vec3::Zero();
@@ -141,17 +201,27 @@ bool ScaleEstimator::reducedSystem(ReducedVec& step, double& chi2, int& residual
     const Vec3 d = kf_T_[w].t - kf_T_[oldest_].t;
     if (f >= 0 && d.norm() > 0) g_.segment<3>(6 * f) = kf_T_[w].R.transpose() * d / (d.norm() * sum);
   }
-  // The variance of u (in units of the pixel sigmas) from the undamped system. The damping below only steadies
-  // the step: where the window does not constrain the scale it would pose as information (measured: a straight
+  // The variance of u (in units of the pixel sigmas) from the undamped system. The damping of dampedStep() only
+  // steadies the step: where the window does not constrain the scale it would pose as information (measured: a straight
   // synthetic window's sigma 5360% became 21%; a window of the rendered 10 cm rig 93% became 3.8%).
   const Eigen::LDLT<Reduced> exact(S_);
   scale_variance_ = exact.info() == Eigen::Success ? g_.dot(exact.solve(g_)) : INFINITY;
   if (!(scale_variance_ > 0)) scale_variance_ = INFINITY;  // singular or indefinite: the scale is not observed
-  S_.diagonal().array() += 1e-9 + 1e-6 * S_.diagonal().array();
-  const Eigen::LDLT<Reduced> ldlt(S_);
+  if (hold_scale_) {  // a stiff prior keeps u where the profile put it
+    constexpr double kHoldWeight = 1e10;
+    S_.noalias() += kHoldWeight * g_ * g_.transpose();
+    b_.noalias() += kHoldWeight * (std::log(sum) - held_u_) * g_;
+  }
+  return b_.allFinite() && std::isfinite(scale_variance_);
+}
+
+bool ScaleEstimator::dampedStep(double lambda, ReducedVec& step) {
+  damped_ = S_;
+  damped_.diagonal().array() += 1e-9 + lambda * S_.diagonal().array();
+  const Eigen::LDLT<Reduced> ldlt(damped_);
   if (ldlt.info() != Eigen::Success) return false;
   step = ldlt.solve(-b_);
-  return step.allFinite() && std::isfinite(scale_variance_);
+  return step.allFinite();
 }
 
 ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
@@ -210,63 +280,42 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   const double scale_before = scaleOfPoses();
   if (!(scale_before > 0)) return out;
 
-  // 1. Coarse (max_ratio > 1): scan log s, then golden-section search around the best sample.
-  double s_coarse = 1.0;
+  // 1. Coarse (max_ratio > 1): the profile of the cost over log s, from the map's unit outwards both ways; each
+  //    factor starts from its neighbour's re-fitted window, scaled.
   if (max_ratio > 1.0) {
     const double umax = std::log(max_ratio);
-    const int steps = std::max(2, static_cast<int>(std::ceil(umax / std::log(1.25))));
+    const int steps = std::max(2, static_cast<int>(std::ceil(umax / std::log(kProfileRatio))));
     const double du = umax / steps;
+    saveWindow(kf_start_, lm_start_);
+    hold_scale_ = true;
     int best = 0;
     double best_cost = std::numeric_limits<double>::infinity();
-    for (int i = -steps; i <= steps; ++i) {
-      const double c = cost(std::exp(i * du));
-      if (c < best_cost) {
-        best_cost = c;
-        best = i;
+    for (const int dir : {1, -1}) {
+      restoreWindow(kf_start_, lm_start_);
+      for (int k = dir > 0 ? 0 : 1; k <= steps; ++k) {
+        if (k > 0) scaleWindow(std::exp(dir * du));
+        held_u_ = std::log(scaleOfPoses());
+        double c = 0, u_step = 0;
+        if (!refine(kProfileSteps, c, u_step)) break;
+        if (c < best_cost) {
+          best_cost = c;
+          best = dir * k;
+          saveWindow(kf_best_, lm_best_);
+        }
       }
     }
+    hold_scale_ = false;
     if (best == -steps || best == steps) return out;  // no minimum inside the range: the window says nothing
-    constexpr double kGolden = 0.6180339887498949;
-    double a = (best - 1) * du, b = (best + 1) * du;
-    double x1 = b - kGolden * (b - a), x2 = a + kGolden * (b - a);
-    double f1 = cost(std::exp(x1)), f2 = cost(std::exp(x2));
-    while (b - a > 1e-3) {
-      if (f1 < f2) {
-        b = x2;
-        x2 = x1;
-        f2 = f1;
-        x1 = b - kGolden * (b - a);
-        f1 = cost(std::exp(x1));
-      } else {
-        a = x1;
-        x1 = x2;
-        f1 = f2;
-        x2 = a + kGolden * (b - a);
-        f2 = cost(std::exp(x2));
-      }
-    }
-    s_coarse = std::exp(0.5 * (a + b));
+    restoreWindow(kf_best_, lm_best_);
   }
-  for (int w = 0; w < nk_; ++w) kf_T_[w].t *= s_coarse;
-  for (int l = 0; l < nl_; ++l) lm_p_[l] *= s_coarse;
 
-  // 2. Fine: Gauss-Newton on the whole window; the last system gives the marginal sigma.
-  ReducedVec step;
-  double chi2 = 0, first_chi2 = 0, last_u_step = 0;
+  // 2. Fine: Levenberg-Marquardt on the whole window, the scale free; the last system gives the marginal sigma.
+  double c = 0, last_u_step = 0, chi2 = 0;
   int residuals = 0;
-  for (int it = 0;; ++it) {
-    if (!reducedSystem(step, chi2, residuals)) return out;
-    if (it == 0) first_chi2 = chi2;
-    if (it == kGaussNewtonSteps) break;
-    last_u_step = g_.dot(step);  // first-order change of u by this step
-    for (int w = 0; w < nk_; ++w) {
-      const int f = freeIndex(w);
-      if (f >= 0) kf_T_[w] = kf_T_[w] * SE3::exp(step.segment<6>(6 * f));
-    }
-  }
-  // Gauss-Newton that raised the cost, or still moves the scale by more than its sigma, has not found the
-  // window's minimum: its curvature says nothing about the scale.
-  if (!(chi2 <= first_chi2) || !(last_u_step * last_u_step <= scale_variance_)) return out;
+  if (!refine(kGaussNewtonSteps, c, last_u_step) || !reducedSystem(chi2, residuals)) return out;
+  // A refinement that still moved the scale by more than its sigma has not found the window's minimum: its
+  // curvature says nothing about the scale.
+  if (!(last_u_step * last_u_step <= scale_variance_)) return out;
   const double dof = std::max(1.0, 2.0 * residuals - 3.0 * nl_ - 6.0 * (nk_ - 1));
   out.reduced_chi2 = chi2 / dof;
   const double reduced = std::max(1.0, out.reduced_chi2);

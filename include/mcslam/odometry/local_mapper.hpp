@@ -103,9 +103,10 @@ class LocalMapper {
     int distance = 257, second = 257;
     int cam = -1;
     int32_t kp = -1;
+    bool free = false;               // without a landmark yet (the others only compete)
   };
   std::vector<Best> best_;
-  EpipolarBandIndex band_index_;     // the old camera's free keypoints, by epipolar half-plane
+  EpipolarBandIndex band_index_;     // the old camera's keypoints, by epipolar half-plane
   std::vector<double> gate_;         // per octave: sine distance to the epipolar plane allowed
   bool scene_referenced_points_ = false;
   std::vector<double> inverse_ranges_;  // scratch of sceneInverseDepth(): one per keypoint of a keyframe

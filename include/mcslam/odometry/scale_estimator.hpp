@@ -5,11 +5,15 @@
 // reprojections through the metric extrinsics.
 //
 // Over the back-end's window (extrinsics held at the calibration, the oldest keyframe fixed):
-//  1. coarse: keyframe positions relative to the oldest keyframe and the landmarks multiplied by one factor,
-//     every landmark re-triangulated for it (rotations held); a scan over log s brings a map whose unit is
-//     far off into the basin;
-//  2. fine: Gauss-Newton on the whole window (poses and landmarks, landmarks eliminated by the Schur
-//     complement) from there. The scale is u = log of the summed keyframe distances from the oldest one; its
+//  1. coarse: the profile of the cost over log s. At each factor the keyframe positions (relative to the
+//     oldest) and the landmarks are multiplied by it and the window is re-fitted with u held there. Scaling
+//     alone, poses otherwise held, favours the map's own unit: tracking and the back-end fitted the poses in
+//     that unit, absorbing what the lever arms disagree with, so every other unit costs more until the poses
+//     are re-fitted (measured on a synthetic small room: the scaled scan's minimum at the map's unit, the
+//     profile's at 0.43 for a truth of 0.40). The profile brings a map whose unit is far off into the basin;
+//  2. fine: Levenberg-Marquardt on the whole window (poses and landmarks, landmarks eliminated by the Schur
+//     complement) from there, only steps that lower the cost taken (plain Gauss-Newton once jumped into a
+//     state whose sigma was 0.05% and whose scale was 50% off). The scale is u = log of the summed keyframe distances from the oldest one; its
 //     sigma is the MARGINAL one (g^T S^-1 g over the reduced pose system), inflated by the reduced chi-square:
 //     holding the poses would give a sigma many times too small, as the poses absorb much of a scale error.
 // The caller applies exp(u) - the window's scale, nothing else (the back-end refines the rest).
@@ -45,7 +49,7 @@ class ScaleEstimator {
                  float octave_scale_factor, int levels);
 
   // Uses the keyframes with in_backend set and the landmarks two of them observe. `max_ratio` bounds the
-  // coarse search: s in [1 / max_ratio, max_ratio]; at most 1, Gauss-Newton starts from the map as it is.
+  // coarse search: s in [1 / max_ratio, max_ratio]; at most 1, the refinement starts from the map as it is.
   ScaleEstimate estimate(const Map& map, double max_ratio);
   static constexpr int kMaxKeyframes = 16;
 
@@ -59,12 +63,20 @@ class ScaleEstimator {
     Vec2 uv;
     double inv_sigma;
   };
-  double cost(double s, int* residuals = nullptr);
-  // Robust cost of landmark l at p (refined first when asked), keyframes at kf_T_ with positions times s.
-  double landmarkCost(int l, double s, Vec3& p, bool refine, int* residuals);
-  // One Gauss-Newton step of the window from kf_T_ / lm_p_ (landmarks re-triangulated first), and the
-  // variance of u it implies. False when singular.
-  bool reducedSystem(ReducedVec& step, double& chi2, int& residuals);
+  double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
+  // Robust cost of landmark l at p (refined first when asked), keyframes at kf_T_.
+  double landmarkCost(int l, Vec3& p, bool refine, int* residuals);
+  // Up to `steps` Levenberg-Marquardt steps from kf_T_ / lm_p_ (only steps that lower the cost are taken).
+  // c: the cost at the end; u_step: how much the last step taken moved u (first order). False when the
+  // system is not finite.
+  bool refine(int steps, double& c, double& u_step);
+  void scaleWindow(double s);  // keyframe positions and landmarks times s, about the centre
+  void saveWindow(std::vector<SE3>& kf, std::vector<Vec3>& lm) const;
+  void restoreWindow(const std::vector<SE3>& kf, const std::vector<Vec3>& lm);
+  // The reduced (Schur-complemented) system of the window at kf_T_ / lm_p_ (landmarks re-triangulated first),
+  // and the variance of u it implies. False when not finite.
+  bool reducedSystem(double& chi2, int& residuals);
+  bool dampedStep(double lambda, ReducedVec& step);  // solves (S + lambda diag S) step = -b
   double scaleOfPoses() const;  // summed distances of the keyframes from the oldest (the centre)
   // Block of window keyframe w in the reduced pose system (-1: the oldest, held).
   int freeIndex(int w) const { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); }
@@ -75,10 +87,15 @@ class ScaleEstimator {
   std::vector<SE3> T_c_b_;     // per camera, from the rig at the start of estimate() (its extrinsics may follow
                                // the back-end's)
   std::vector<SE3> kf_T_;      // per window keyframe: T_w_b, translation relative to the centre
+  std::vector<SE3> kf_before_;  // kf_T_ before a refinement step
+  std::vector<SE3> kf_start_, kf_best_;  // the window as the map has it, and the profile's best fit
+  std::vector<Vec3> lm_start_, lm_best_;
   int oldest_ = 0;              // window index of the oldest keyframe (held)
-  Reduced S_;
+  Reduced S_, damped_;
   ReducedVec b_, g_;
   double scale_variance_ = 0;  // g^T S^-1 g of the last reduced system
+  bool hold_scale_ = false;    // reducedSystem() keeps u at held_u_ (the profile's fits)
+  double held_u_ = 0;
   std::vector<int> kf_slot_of_;  // map keyframe slot -> window index (-1)
   std::vector<Vec3> lm_p_;      // per landmark: position relative to the centre
   std::vector<int> lm_first_;   // per landmark: first observation (lm_first_[l + 1] ends it)
