@@ -13,8 +13,8 @@
 //     profile's at 0.43 for a truth of 0.40). The profile brings a map whose unit is far off into the basin;
 //  2. fine: Levenberg-Marquardt on the whole window (poses and landmarks, landmarks eliminated by the Schur
 //     complement) from there, only steps that lower the cost taken (plain Gauss-Newton once jumped into a
-//     state whose sigma was 0.05% and whose scale was 50% off). The scale is u = log of the summed keyframe distances from the oldest one; its
-//     sigma is the MARGINAL one (g^T S^-1 g over the reduced pose system), inflated by the reduced chi-square:
+//     state whose sigma was 0.05% and whose scale was 50% off). The scale is u = log of the summed keyframe
+//     distances from the oldest one; its sigma is the MARGINAL one (g^T S^-1 g over the reduced pose system), inflated by the reduced chi-square:
 //     holding the poses would give a sigma many times too small, as the poses absorb much of a scale error.
 // The caller applies exp(u) - the window's scale, nothing else (the back-end refines the rest).
 // Fixed memory: buffers sized at construction (the reduced system is at most kMaxKeyframes poses).
