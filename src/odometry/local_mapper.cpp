@@ -277,6 +277,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
   // multi-view features give every frame its metres, the own bounds stay: they reject points whose depth is
   // imprecise, which tracking takes as exact (the scene bound made 5-frame spans of the first 50 frames of the
   // 5-camera sequence up to 8% long). A keyframe without a scene yet (initialization) uses the own bounds too.
+  //
   // Where the map's unit rests on these points, keypoints that already have a landmark take part in the ratio
   // test too (and are never chosen). Without them a lookalike on the epipolar line stood unopposed whenever the
   // true partner had a landmark: on the rendered indoor loop up to a quarter of the 10 cm rig's window landmarks

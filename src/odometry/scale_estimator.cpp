@@ -13,7 +13,7 @@ namespace {
 // A ray that no longer projects costs as much as a residual of this many sigmas: large, but bounded, so
 // that the cost stays continuous enough to search.
 constexpr double kMissingSigmas = 10.0;
-constexpr int kGaussNewtonSteps = 6;
+constexpr int kRefineSteps = 6;
 // Levenberg-Marquardt damping (relative to the system's diagonal): a step that does not lower the cost is
 // retried with ten times more, up to the largest (then the window is at its minimum).
 constexpr double kMinDamping = 1e-6, kMaxDamping = 1e4;
@@ -40,7 +40,7 @@ ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observ
   obs_.resize(max_observations);
 }
 
-double ScaleEstimator::landmarkCost(int l, Vec3& p, bool refine, int* residuals) {
+double ScaleEstimator::landmarkCost(int l, Vec3& p) {
   const int begin = lm_first_[l], end = lm_first_[l + 1];
   const double missing = loss_.rho(kMissingSigmas * kMissingSigmas);
   auto cameraPoint = [&](const Obs& o) {
@@ -48,7 +48,7 @@ double ScaleEstimator::landmarkCost(int l, Vec3& p, bool refine, int* residuals)
     const SE3& T = kf_T_[o.kf];
     return Vec3(T_b_c.R.transpose() * (T.R.transpose() * (p - T.t) - T_b_c.t));
   };
-  for (int it = 0; it < (refine ? 2 : 0); ++it) {
+  for (int it = 0; it < 2; ++it) {
     Mat3 H = Mat3::Zero();
     Vec3 g = Vec3::Zero();
     for (int i = begin; i < end; ++i) {
@@ -77,7 +77,6 @@ double ScaleEstimator::landmarkCost(int l, Vec3& p, bool refine, int* residuals)
       continue;
     }
     c += loss_.rho(((uv - o.uv) * o.inv_sigma).squaredNorm());
-    if (residuals) ++*residuals;
   }
   return 0.5 * c;
 }
@@ -86,7 +85,7 @@ double ScaleEstimator::cost() {
   double c = 0;
   for (int l = 0; l < nl_; ++l) {
     Vec3 p = lm_p_[l];
-    c += landmarkCost(l, p, true, nullptr);
+    c += landmarkCost(l, p);
   }
   return c;
 }
@@ -157,7 +156,7 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
   for (int w = 0; w < nk_; ++w) T_b_w[w] = kf_T_[w].inverse();
   for (int l = 0; l < nl_; ++l) {
     Vec3 p = lm_p_[l];
-    landmarkCost(l, p, true, nullptr);  // the landmark's best position for these poses
+    landmarkCost(l, p);  // the landmark's best position for these poses
     lm_p_[l] = p;
     Mat3 Hll = Mat3::Zero();
     Vec3 bl = Vec3::Zero();
@@ -312,7 +311,7 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   // 2. Fine: Levenberg-Marquardt on the whole window, the scale free; the last system gives the marginal sigma.
   double c = 0, last_u_step = 0, chi2 = 0;
   int residuals = 0;
-  if (!refine(kGaussNewtonSteps, c, last_u_step) || !reducedSystem(chi2, residuals)) return out;
+  if (!refine(kRefineSteps, c, last_u_step) || !reducedSystem(chi2, residuals)) return out;
   // A refinement that still moved the scale by more than its sigma has not found the window's minimum: its
   // curvature says nothing about the scale.
   if (!(last_u_step * last_u_step <= scale_variance_)) return out;

@@ -14,8 +14,9 @@
 //  2. fine: Levenberg-Marquardt on the whole window (poses and landmarks, landmarks eliminated by the Schur
 //     complement) from there, only steps that lower the cost taken (plain Gauss-Newton once jumped into a
 //     state whose sigma was 0.05% and whose scale was 50% off). The scale is u = log of the summed keyframe
-//     distances from the oldest one; its sigma is the MARGINAL one (g^T S^-1 g over the reduced pose system), inflated by the reduced chi-square:
-//     holding the poses would give a sigma many times too small, as the poses absorb much of a scale error.
+//     distances from the oldest one; its sigma is the MARGINAL one (g^T S^-1 g over the reduced pose system),
+//     inflated by the reduced chi-square: holding the poses would give a sigma many times too small, as the
+//     poses absorb much of a scale error.
 // The caller applies exp(u) - the window's scale, nothing else (the back-end refines the rest).
 // Fixed memory: buffers sized at construction (the reduced system is at most kMaxKeyframes poses).
 #include <cmath>
@@ -64,8 +65,8 @@ class ScaleEstimator {
     double inv_sigma;
   };
   double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
-  // Robust cost of landmark l at p (refined first when asked), keyframes at kf_T_.
-  double landmarkCost(int l, Vec3& p, bool refine, int* residuals);
+  // Robust cost of landmark l at p, keyframes at kf_T_; p is refined first (two Gauss-Newton steps).
+  double landmarkCost(int l, Vec3& p);
   // Up to `steps` Levenberg-Marquardt steps from kf_T_ / lm_p_ (only steps that lower the cost are taken).
   // c: the cost at the end; u_step: how much the last step taken moved u (first order). False when the
   // system is not finite.
