@@ -55,7 +55,8 @@ Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_featu
   }
   reestimated_.assign(cams, 0);
   if (cams > 1) {
-    const int window_obs = (options.window_keyframes + 1) * cams * max_features_per_camera;
+    const int scale_keyframes = std::min(map_.keyframeCapacity(), ScaleEstimator::kMaxKeyframes);
+    const int window_obs = scale_keyframes * cams * max_features_per_camera;
     scale_estimator_ = std::make_unique<ScaleEstimator>(rig_, std::min(options.max_landmarks, window_obs), window_obs,
                                                         map_.keyframeCapacity(), options.scale_factor, options.levels);
     scale_filter_ = std::make_unique<ScaleFilter>();
@@ -233,7 +234,6 @@ void Odometry::estimateScale() {
   // thread most of a frame: a rig whose scale never converges would pay it at every keyframe).
   constexpr double kMinWindowTurnRad = 2.0 * M_PI / 180.0;
   if (windowTurn() < kMinWindowTurnRad) return;
-  const int new_keyframes = keyframes_since_scale_;
   keyframes_since_scale_ = 0;
   // The search range: the whole of it while the unit is arbitrary; within a factor 2 once the combined windows
   // know it to 20% (the search re-fits the window at every factor it tries: the range is most of its cost).
@@ -246,7 +246,7 @@ void Odometry::estimateScale() {
   if (!e.ok) return;
   stats_.last_scale = e.scale;
   stats_.last_scale_sigma = e.relative_sigma;
-  if (!scale_filter_->add(std::log(e.scale), e.relative_sigma, e.keyframes, new_keyframes, rotation_travelled_)) {
+  if (!scale_filter_->add(std::log(e.scale), e.relative_sigma, e.oldest_id, e.newest_id, rotation_travelled_)) {
     return;  // an outlier
   }
   const double x = scale_filter_->correction(), sigma = scale_filter_->sigma();

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
+#include <bit>
 #include <limits>
 
 #include "mcslam/backend/reprojection_residual.hpp"
@@ -27,6 +28,7 @@ ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observ
                                float octave_scale_factor, int levels)
     : rig_(rig) {
   kf_slot_of_.resize(max_keyframes);
+  kf_order_.resize(max_keyframes);
   for (int o = 0; o < std::max(levels, 1); ++o) octave_sigma_.push_back(std::pow(octave_scale_factor, o));
   kf_T_.resize(kMaxKeyframes);
   kf_before_.resize(kMaxKeyframes);
@@ -226,41 +228,52 @@ bool ScaleEstimator::dampedStep(double lambda, ReducedVec& step) {
 ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   ScaleEstimate out;
   for (int c = 0; c < rig_.size(); ++c) T_c_b_[c] = rig_.T_b_c(c).inverse();
-  // The window's keyframes; the oldest is the centre (the back-end holds it fixed).
+  // The window: the map's newest live keyframes (up to kMaxKeyframes), the back-end's and the older ones kept for
+  // tracking: a window that spans a whole turn sees the lever arms move most. The oldest is the centre, held.
   if (map.keyframeCapacity() > static_cast<int>(kf_slot_of_.size())) return out;  // not the map it was sized for
   std::fill(kf_slot_of_.begin(), kf_slot_of_.end(), -1);
-  nk_ = 0;
+  int live = 0;
   for (int i = 0; i < map.keyframeCapacity(); ++i) {
-    const Keyframe& k = map.keyframe(i);
-    if (!k.alive || !k.in_backend) continue;
-    if (nk_ >= kMaxKeyframes) return out;
-    kf_slot_of_[i] = nk_++;
+    if (map.keyframe(i).alive) kf_order_[live++] = i;
   }
+  nk_ = std::min(live, kMaxKeyframes);
   out.keyframes = nk_;
   if (nk_ < 3) return out;
-  const int oldest = map.oldestWindowKeyframe();
+  auto newer = [&](int a, int b) { return map.keyframe(a).id > map.keyframe(b).id; };
+  std::nth_element(kf_order_.begin(), kf_order_.begin() + (nk_ - 1), kf_order_.begin() + live, newer);
+  int oldest = kf_order_[0], newest = kf_order_[0];
+  for (int w = 0; w < nk_; ++w) {
+    const int i = kf_order_[w];
+    kf_slot_of_[i] = w;
+    if (newer(oldest, i)) oldest = i;
+    if (newer(i, newest)) newest = i;
+  }
   out.center = map.keyframe(oldest).T_w_b.t;
   oldest_ = kf_slot_of_[oldest];
-  for (int i = 0; i < map.keyframeCapacity(); ++i) {
-    if (kf_slot_of_[i] < 0) continue;
-    kf_T_[kf_slot_of_[i]] = map.keyframe(i).T_w_b;
-    kf_T_[kf_slot_of_[i]].t -= out.center;
+  out.oldest_id = map.keyframe(oldest).id;
+  out.newest_id = map.keyframe(newest).id;
+  for (int w = 0; w < nk_; ++w) {
+    kf_T_[w] = map.keyframe(kf_order_[w]).T_w_b;
+    kf_T_[w].t -= out.center;
   }
-  // Landmarks seen from two window keyframes, with their window observations.
+  // Landmarks seen from at least three window keyframes, with their window observations. A landmark of two
+  // keyframes was created by an epipolar search at the map's poses: its two rays were chosen because they meet
+  // there, so it agrees with the map's unit whether or not it is a lookalike (a quarter of the 10 cm rig's window
+  // landmarks were, audited against rendered depth). A third keyframe's observation is a test it could fail.
   nl_ = 0;
   no_ = 0;
   for (int lm = 0; lm < map.landmarkCapacity() && nl_ < static_cast<int>(lm_p_.size()); ++lm) {
     const Landmark& L = map.landmark(lm);
     if (!L.alive) continue;
-    int first_kf = -1, distinct = 0, n = 0;
+    int n = 0;
+    uint32_t seen_by = 0;  // bit per window keyframe
     for (int j = 0; j < L.obs_count; ++j) {
       const int w = kf_slot_of_[L.obs[j].keyframe];
       if (w < 0) continue;
       ++n;
-      if (first_kf < 0) first_kf = w;
-      distinct = w != first_kf ? 2 : std::max(distinct, 1);
+      seen_by |= 1u << w;
     }
-    if (distinct < 2 || no_ + n > static_cast<int>(obs_.size())) continue;
+    if (std::popcount(seen_by) < kMinLandmarkKeyframes || no_ + n > static_cast<int>(obs_.size())) continue;
     lm_first_[nl_] = no_;
     for (int j = 0; j < L.obs_count; ++j) {
       const int w = kf_slot_of_[L.obs[j].keyframe];
@@ -326,19 +339,32 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   return out;
 }
 
-bool ScaleFilter::add(double log_scale, double sigma, int window_keyframes, int new_keyframes, double rotation) {
-  const int window = std::max(1, window_keyframes);
-  const double r = sigma * sigma * window / std::clamp(new_keyframes, 1, window);
-  if (info_ > 0 && (log_scale - x_) * (log_scale - x_) > 9.0 * (r + 1.0 / info_)) {
-    // One window off by 3 sigma is an outlier; several in a row (they share keyframes) mean the map's scale moved.
+double ScaleFilter::correction() const {
+  const double i = info();
+  return i > 0 ? (committed_.x * committed_.info + pending_.x * pending_.info) / i : 0.0;
+}
+
+bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t newest_id, double rotation) {
+  const double info_new = 1.0 / (sigma * sigma);
+  if (!std::isfinite(log_scale) || !(info_new > 0) || !std::isfinite(info_new)) return false;
+  const double x = correction();
+  if (info() > 0 && (log_scale - x) * (log_scale - x) > 9.0 * (sigma * sigma + 1.0 / info())) {
+    // One window off by 3 sigma is an outlier; several in a row mean the map's scale moved.
     if (++rejected_ < kRestartAfter) return false;
-    info_ = 0;
+    committed_ = pending_ = Part{};
   }
   rejected_ = 0;
-  if (info_ == 0) first_rotation_ = rotation;
+  if (info() == 0) first_rotation_ = rotation;
   last_rotation_ = rotation;
-  x_ = (x_ * info_ + log_scale / r) / (info_ + 1.0 / r);
-  info_ += 1.0 / r;
+  if (pending_.info > 0 && oldest_id > pending_newest_) {  // no keyframe shared: the pending window is final
+    committed_.x = (committed_.x * committed_.info + pending_.x * pending_.info) / (committed_.info + pending_.info);
+    committed_.info += pending_.info;
+    pending_ = Part{};
+  }
+  if (info_new >= pending_.info) {
+    pending_ = Part{log_scale, info_new};
+    pending_newest_ = newest_id;
+  }
   return true;
 }
 

@@ -105,14 +105,7 @@ TEST(ScaleEstimator, EstimatesAllocateNothing) {
   ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 14, 1.2f, 8);
   alloc::ThreadScope scope;
   const ScaleEstimate full = est.estimate(map, 30.0);
-  int left = 0;
-  for (int i = 0; i < map.keyframeCapacity() && left < 3; ++i) {  // three keyframes leave the window
-    Keyframe& kf = map.keyframe(i);
-    if (kf.alive && kf.in_backend && i != map.oldestWindowKeyframe()) {
-      kf.in_backend = false;
-      ++left;
-    }
-  }
+  for (int left = 0; left < 3; ++left) map.eraseKeyframe(map.newestKeyframe());  // three keyframes leave
   const ScaleEstimate smaller = est.estimate(map, 1.0);
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_TRUE(full.ok);
@@ -125,16 +118,35 @@ TEST(ScaleEstimator, EstimatesAllocateNothing) {
 TEST(ScaleFilter, RotationSpanCountsFromTheFirstEstimateKept) {
   ScaleFilter f;
   EXPECT_EQ(f.rotationSpan(), 0.0);
-  EXPECT_TRUE(f.add(0.0, 0.02, 8, 8, 1.0));
-  EXPECT_TRUE(f.add(0.01, 0.02, 8, 4, 2.5));
+  EXPECT_TRUE(f.add(0.0, 0.02, 0, 13, 1.0));
+  EXPECT_TRUE(f.add(0.01, 0.02, 4, 17, 2.5));
   EXPECT_DOUBLE_EQ(f.rotationSpan(), 1.5);
   // Three windows in a row far off: the map's scale moved, the combination restarts from the third.
-  EXPECT_FALSE(f.add(1.0, 0.02, 8, 1, 3.0));
-  EXPECT_FALSE(f.add(1.0, 0.02, 8, 1, 3.2));
-  EXPECT_TRUE(f.add(1.0, 0.02, 8, 1, 3.4));
+  EXPECT_FALSE(f.add(1.0, 0.02, 5, 18, 3.0));
+  EXPECT_FALSE(f.add(1.0, 0.02, 6, 19, 3.2));
+  EXPECT_TRUE(f.add(1.0, 0.02, 7, 20, 3.4));
   EXPECT_DOUBLE_EQ(f.rotationSpan(), 0.0);
-  EXPECT_TRUE(f.add(1.0, 0.02, 8, 1, 4.0));
+  EXPECT_TRUE(f.add(1.0, 0.02, 8, 21, 4.0));
   EXPECT_NEAR(f.rotationSpan(), 0.6, 1e-12);
   f.reset();
   EXPECT_EQ(f.rotationSpan(), 0.0);
+}
+
+// Of windows that share keyframes only the most certain counts (the later ones of a turn hold the earlier
+// ones' keyframes and more of the turn); windows that share none are independent and their information adds.
+TEST(ScaleFilter, OverlappingWindowsCountOnceDisjointOnesAdd) {
+  ScaleFilter f;
+  EXPECT_TRUE(f.add(0.10, 0.20, 0, 13, 0.0));   // before the turn: little information
+  EXPECT_TRUE(f.add(0.20, 0.03, 3, 16, 0.5));   // in it: this one supersedes the first
+  EXPECT_NEAR(f.correction(), 0.20, 1e-12);
+  EXPECT_NEAR(f.sigma(), 0.03, 1e-12);
+  EXPECT_TRUE(f.add(0.19, 0.05, 6, 19, 0.9));   // less certain, overlapping: adds nothing
+  EXPECT_NEAR(f.sigma(), 0.03, 1e-12);
+  EXPECT_TRUE(f.add(0.22, 0.03, 17, 30, 3.0));  // shares no keyframe with the pending one: both count
+  EXPECT_NEAR(f.correction(), 0.21, 1e-12);
+  EXPECT_NEAR(f.sigma(), 0.03 / std::sqrt(2.0), 1e-12);
+  // The map takes the correction: the estimates stay, relative to its new unit.
+  f.applied();
+  EXPECT_NEAR(f.correction(), 0.0, 1e-12);
+  EXPECT_NEAR(f.sigma(), 0.03 / std::sqrt(2.0), 1e-12);
 }

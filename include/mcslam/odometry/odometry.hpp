@@ -98,7 +98,7 @@ class Odometry {
   void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
   void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
-  // Estimates the scale of a map started up to scale over the back-end's window at every keyframe, and
+  // Estimates the scale of a map started up to scale over its newest keyframes at every keyframe, and
   // rescales the map when the combined estimate is certain (the first time: the scale has converged) or
   // significantly off.
   void estimateScale();

@@ -35,7 +35,7 @@ struct OdometryOptions {
   int init_min_multiview = 40;     // metric multi-view features needed to initialize from one frame
   int init_max_reference_age = 40; // two-frame initialization: renew the reference frame after this many frames
   int init_min_matches = 60;
-  // Scale of a rig without overlap, estimated over the back-end's window: the map becomes metric when the
+  // Scale of a rig without overlap, estimated over the map's newest keyframes: the map becomes metric when the
   // estimate's sigma(s)/s is below this (3 sigma inside the 5% the issue asks for), searched within this
   // factor either way of the current unit.
   double scale_max_sigma = 0.05 / 3.0;
