@@ -347,6 +347,13 @@ double ScaleFilter::correction() const {
 bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t newest_id, double rotation) {
   const double info_new = 1.0 / (sigma * sigma);
   if (!std::isfinite(log_scale) || !(info_new > 0) || !std::isfinite(info_new)) return false;
+  if (last_newest_ >= 0 && newest_id > last_newest_ && drift_variance_ > 0) {
+    const double q = drift_variance_ * static_cast<double>(newest_id - last_newest_);
+    for (Part* p : {&committed_, &pending_}) {
+      if (p->info > 0) p->info = 1.0 / (1.0 / p->info + q);
+    }
+  }
+  last_newest_ = std::max(last_newest_, newest_id);
   const double x = correction();
   if (info() > 0 && (log_scale - x) * (log_scale - x) > 9.0 * (sigma * sigma + 1.0 / info())) {
     // One window off by 3 sigma is an outlier; several in a row mean the map's scale moved.

@@ -106,7 +106,9 @@ static void expectMetricScaleOnceConverged(const test::SyntheticSequenceOptions&
   EXPECT_EQ(r.first_metric, r.stats.scale_converged_frame);
   EXPECT_EQ(r.unscaled_after_metric, 0);
   EXPECT_GE(r.stats.scale_rescales, 1u);
-  EXPECT_LE(r.stats.combined_scale_sigma, OdometryOptions{}.scale_max_sigma);
+  // Converging took the bound; afterwards the filter lets the unit drift between turns (its sigma grows on a
+  // straight, shrinks in a turn), but it stays well inside the 5%.
+  EXPECT_LE(r.stats.combined_scale_sigma, 0.05 / 2.0);
   test::SyntheticSequence seq(test::nonOverlappingRig3(), so);
   // 'Before': the first half of the frames up to convergence (a confident correction may come before it).
   const Timestamp t_converged = seq.truth(static_cast<int>(r.stats.scale_converged_frame)).t;
@@ -129,8 +131,9 @@ static void expectMetricScaleOnceConverged(const test::SyntheticSequenceOptions&
   EXPECT_LT(ate_after, 0.2);
 }
 
-// On the wobbly circle (always turning). 480 frames: the scale converges at frame 109, then 0.997 and ATE 0.015 m
-// (164 with windows of the back-end's keyframes and a filter that weighed windows by their new keyframes; 323
+// On the wobbly circle (always turning). 480 frames: the scale converges at frame 109, then 1.001 and ATE 0.063 m
+// (0.015 m when the map held its unit after convergence: following the drift model costs it a few rescales of
+// 1-3%; 164 with windows of the back-end's keyframes and a filter that weighed windows by their new keyframes; 323
 // with the scaled scan instead of the profile; 0.16 m, 1.042 when the sigmas were the damping's and the
 // window was free until convergence).
 TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
@@ -141,7 +144,7 @@ TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
 
 // On straights and 48 deg/s corners, the shape of the rendered indoor loop (where the 10 cm rig's windows agreed
 // with whatever unit the map had: the scaled scan and lookalike matches, BENCHMARKS.md 7b): with exact geometry the
-// windows find the metric scale from a start 0.50x off: converged at frame 289, then 0.987, ATE 0.075 m (489,
+// windows find the metric scale from a start 0.50x off: converged at frame 289, then 0.991, ATE 0.057 m (489,
 // 0.980, 0.116 m before windows of the newest 16 keyframes and the filter that counts overlapping windows once).
 TEST(OdometrySynthetic, ThreeNonOverlappingCamerasFindTheScaleInCorners) {
   test::SyntheticSequenceOptions so;

@@ -150,3 +150,22 @@ TEST(ScaleFilter, OverlappingWindowsCountOnceDisjointOnesAdd) {
   EXPECT_NEAR(f.correction(), 0.0, 1e-12);
   EXPECT_NEAR(f.sigma(), 0.03 / std::sqrt(2.0), 1e-12);
 }
+
+// With a drift set (after convergence) what is known of the unit fades over the keyframes between windows: the
+// next turn's windows then correct the straight's drift instead of being averaged with the turn before.
+TEST(ScaleFilter, WithADriftWhatIsKnownFadesOverKeyframes) {
+  for (const bool drift : {false, true}) {
+    ScaleFilter f;
+    EXPECT_TRUE(f.add(0.0, 0.02, 0, 13, 0.0));
+    if (drift) f.setDrift(0.01);
+    EXPECT_TRUE(f.add(0.08, 0.02, 50, 63, 1.0));  // 50 keyframes later, sharing none
+    if (drift) {
+      const double faded = 1.0 / (0.02 * 0.02 + 50 * 0.01 * 0.01), fresh = 1.0 / (0.02 * 0.02);
+      EXPECT_NEAR(f.correction(), 0.08 * fresh / (faded + fresh), 1e-12);  // 0.0745
+      EXPECT_NEAR(f.sigma(), 1.0 / std::sqrt(faded + fresh), 1e-12);
+    } else {
+      EXPECT_NEAR(f.correction(), 0.04, 1e-12);
+      EXPECT_NEAR(f.sigma(), 0.02 / std::sqrt(2.0), 1e-12);
+    }
+  }
+}

@@ -141,7 +141,6 @@ class Odometry {
   int64_t last_init_reference_ = -1;
   bool scale_converged_ = true;
   bool scale_free_start_ = false;  // the map started up to scale: its scale is estimated at keyframes
-  int keyframes_since_scale_ = 0;
   double rotation_travelled_ = 0;  // radians the rig has turned through since the start, frame to frame
   uint64_t frame_index_ = 0;      // of the frame being processed
   OdometryStats stats_;

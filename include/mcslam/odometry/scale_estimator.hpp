@@ -118,12 +118,16 @@ class ScaleEstimator {
 // is dropped; when several in a row disagree, the map's scale has drifted (a straight stretch hides it) and the
 // combination restarts from the latest. Windows of one turn also share their scene and the map's history:
 // rotationSpan() says over how much rotation of the rig (radians travelled, `rotation` of add()) the combined
-// estimates were gathered.
+// estimates were gathered. With a drift set (once the odometry declared the scale), what is known of the unit
+// fades with the keyframes since: the estimates of one turn then correct the drift of the straight before it.
+// (Before that the combination tests whether windows of different turns agree on one unit; drift there shows
+// as disagreement, and the combination restarts.)
 class ScaleFilter {
  public:
   void reset() {
     committed_ = pending_ = Part{};
-    pending_newest_ = -1;
+    pending_newest_ = last_newest_ = -1;
+    drift_variance_ = 0;
     rejected_ = 0;
     first_rotation_ = last_rotation_ = 0;
   }
@@ -133,6 +137,8 @@ class ScaleFilter {
   double correction() const;  // log of the factor the map needs
   double sigma() const { return info() > 0 ? 1.0 / std::sqrt(info()) : INFINITY; }
   double rotationSpan() const { return last_rotation_ - first_rotation_; }
+  // From now on the unit random-walks by this relative sigma per keyframe (0: it holds).
+  void setDrift(double sigma_per_keyframe) { drift_variance_ = sigma_per_keyframe * sigma_per_keyframe; }
   // The map took the correction: the estimates stay, relative to its new unit.
   void applied() {
     const double x = correction();
@@ -148,6 +154,8 @@ class ScaleFilter {
   static constexpr int kRestartAfter = 3;
   Part committed_, pending_;
   int64_t pending_newest_ = -1;  // newest keyframe id of the pending window
+  int64_t last_newest_ = -1;     // newest keyframe id of any window added
+  double drift_variance_ = 0;    // per keyframe
   int rejected_ = 0;
   double first_rotation_ = 0, last_rotation_ = 0;
 };
