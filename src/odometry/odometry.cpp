@@ -260,7 +260,8 @@ void Odometry::estimateScale() {
   // an estimate), the poses staying flagged unscaled until the combined sigma reaches the bound.
   const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma &&
                          scale_filter_->rotationSpan() >= options_.scale_min_rotation_deg * M_PI / 180.0;
-  // Once converged the map follows the combined estimate as the unit drifts, whenever it is off by a sigma.
+  // Once converged the map follows the combined estimate as the unit drifts, whenever it is 2 sigma off (1 sigma:
+  // about the same result, twice the rescales).
   const double significant = scale_converged_ ? 2.0 : 3.0;
   if (!converges && !(std::abs(x) > significant * sigma)) return;
   // The whole live map, the window and the motion model take the new unit at once.
