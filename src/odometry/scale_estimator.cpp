@@ -339,11 +339,6 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   return out;
 }
 
-double ScaleFilter::correction() const {
-  const double i = info();
-  return i > 0 ? (committed_.x * committed_.info + pending_.x * pending_.info) / i : 0.0;
-}
-
 bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t newest_id, double rotation) {
   const double info_new = 1.0 / (sigma * sigma);
   if (!std::isfinite(log_scale) || !(info_new > 0) || !std::isfinite(info_new)) return false;
@@ -364,8 +359,7 @@ bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t
   if (info() == 0) first_rotation_ = rotation;
   last_rotation_ = rotation;
   if (pending_.info > 0 && oldest_id > pending_newest_) {  // no keyframe shared: the pending window is final
-    committed_.x = (committed_.x * committed_.info + pending_.x * pending_.info) / (committed_.info + pending_.info);
-    committed_.info += pending_.info;
+    committed_ = fuse(committed_, pending_);
     pending_ = Part{};
   }
   if (info_new >= pending_.info) {

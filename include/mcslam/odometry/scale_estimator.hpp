@@ -51,8 +51,8 @@ class ScaleEstimator {
                  float octave_scale_factor, int levels);
 
   // Uses the map's newest live keyframes (up to kMaxKeyframes) and the landmarks that kMinLandmarkKeyframes of
-  // them observe. `max_ratio` bounds the
-  // coarse search: s in [1 / max_ratio, max_ratio]; at most 1, the refinement starts from the map as it is.
+  // them observe. `max_ratio` bounds the coarse search: s in [1 / max_ratio, max_ratio]; at most 1, the
+  // refinement starts from the map as it is.
   ScaleEstimate estimate(const Map& map, double max_ratio);
   static constexpr int kMaxKeyframes = 16;
   static constexpr int kMinLandmarkKeyframes = 3;
@@ -134,7 +134,7 @@ class ScaleFilter {
   // False when the estimate was dropped as an outlier. The window spans keyframe ids [oldest_id, newest_id];
   // `rotation`: the rig's rotation travelled so far.
   bool add(double log_scale, double sigma, int64_t oldest_id, int64_t newest_id, double rotation);
-  double correction() const;  // log of the factor the map needs
+  double correction() const { return fuse(committed_, pending_).x; }  // log of the factor the map needs
   double sigma() const { return info() > 0 ? 1.0 / std::sqrt(info()) : INFINITY; }
   double rotationSpan() const { return last_rotation_ - first_rotation_; }
   // From now on the unit random-walks by this relative sigma per keyframe (0: it holds).
@@ -150,6 +150,10 @@ class ScaleFilter {
   struct Part {
     double x = 0, info = 0;  // log-scale and its information (0: none)
   };
+  static Part fuse(const Part& a, const Part& b) {  // information-weighted; none from either: none
+    const double info = a.info + b.info;
+    return info > 0 ? Part{(a.x * a.info + b.x * b.info) / info, info} : Part{};
+  }
   double info() const { return committed_.info + pending_.info; }
   static constexpr int kRestartAfter = 3;
   Part committed_, pending_;
