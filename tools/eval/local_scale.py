@@ -5,7 +5,10 @@ A whole-run Sim(3) scale hides a map whose unit drifts (a rig without overlap, o
 scale wanders along the run. Pairs whose true distance is under --min-distance are skipped (a turn in place says
 nothing of the scale). Poses are matched by timestamp (TUM or EuRoC ground truth, seconds or nanoseconds).
 
-  tools/eval/local_scale.py DATASET/groundtruth.txt run.tum [--frames 40] [--series]
+  tools/eval/local_scale.py DATASET/groundtruth.txt run.tum [--frames 40] [--series] [--span FIRST LAST]
+
+--span prints the unit over one stretch: the path the estimate travelled between two poses over the true path
+(indices into the matched poses, negative from the end: --span -120 -1 is how the run finishes).
 """
 import argparse
 import math
@@ -37,6 +40,8 @@ def main():
     ap.add_argument('--frames', type=int, default=40, help='distance over this many frames (default 40)')
     ap.add_argument('--min-distance', type=float, default=0.5, help='metres the truth must move (default 0.5)')
     ap.add_argument('--series', action='store_true', help='also print the local scale every 20 frames')
+    ap.add_argument('--span', nargs=2, type=int, metavar=('FIRST', 'LAST'),
+                    help='also print the path travelled between these poses over the true one')
     a = ap.parse_args()
     gt, est = load(a.groundtruth), load(a.estimate)
     ts = sorted(t for t in est if t in gt)
@@ -49,6 +54,14 @@ def main():
         if d_true < a.min_distance:
             continue
         ratios.append((i, math.dist(est[t0], est[t1]) / d_true))
+    if a.span:
+        first, last = (i + len(ts) if i < 0 else i for i in a.span)
+        if not 0 <= first < last < len(ts):
+            sys.exit(f"--span {a.span[0]} {a.span[1]}: needs two poses in order among the {len(ts)} matched")
+        path = lambda p: sum(math.dist(p[ts[i]], p[ts[i + 1]]) for i in range(first, last))
+        if path(gt) <= 0:
+            sys.exit(f"--span {a.span[0]} {a.span[1]}: the truth does not move there")
+        print(f"unit over poses {first}-{last}: {path(est) / path(gt):.3f}")
     if not ratios:
         sys.exit(f"the truth never moves {a.min_distance} m over {a.frames} frames")
     if a.series:
