@@ -266,6 +266,7 @@ void Odometry::estimateScale() {
   if (!converges && !(std::abs(x) > significant * sigma)) return;
   // The whole live map, the window and the motion model take the new unit at once.
   const double s = std::exp(x);
+  spdlog::debug("odometry: map rescaled by {:.4f} at frame {}", s, frame_index_);
   mapper_->rescale(s, e.center);
   T_w_last_.t = e.center + s * (T_w_last_.t - e.center);
   last_keyframe_pose_.t = e.center + s * (last_keyframe_pose_.t - e.center);

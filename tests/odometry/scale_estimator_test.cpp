@@ -158,14 +158,36 @@ TEST(ScaleFilter, WithADriftWhatIsKnownFadesOverKeyframes) {
     ScaleFilter f;
     EXPECT_TRUE(f.add(0.0, 0.02, 0, 13, 0.0));
     if (drift) f.setDrift(0.01);
-    EXPECT_TRUE(f.add(0.08, 0.02, 50, 63, 1.0));  // 50 keyframes later, sharing none
+    EXPECT_TRUE(f.add(0.06, 0.02, 50, 63, 1.0));  // 50 keyframes later, sharing none
     if (drift) {
       const double faded = 1.0 / (0.02 * 0.02 + 50 * 0.01 * 0.01), fresh = 1.0 / (0.02 * 0.02);
-      EXPECT_NEAR(f.correction(), 0.08 * fresh / (faded + fresh), 1e-12);  // 0.0745
+      EXPECT_NEAR(f.correction(), 0.06 * fresh / (faded + fresh), 1e-12);  // 0.0559
       EXPECT_NEAR(f.sigma(), 1.0 / std::sqrt(faded + fresh), 1e-12);
     } else {
-      EXPECT_NEAR(f.correction(), 0.04, 1e-12);
+      EXPECT_NEAR(f.correction(), 0.03, 1e-12);
       EXPECT_NEAR(f.sigma(), 0.02 / std::sqrt(2.0), 1e-12);
     }
   }
+}
+
+TEST(ScaleFilter, ACertainWindowThatContradictsTheFadedPastOutweighsIt) {
+  // Committed 0 +- 1.5%, faded over 20 keyframes at 1% each to +- 4.7%; then a turn says -0.09 +- 3%: 1.6 sigma
+  // off, more than both sigmas allow, so the committed variance becomes what the disagreement shows.
+  const double var_faded = 0.015 * 0.015 + 20 * 0.01 * 0.01, fresh = 1.0 / (0.03 * 0.03);
+  for (const bool drift : {false, true}) {
+    ScaleFilter f;
+    EXPECT_TRUE(f.add(0.0, 0.015, 0, 13, 0.0));
+    if (drift) f.setDrift(0.01);
+    EXPECT_TRUE(f.add(-0.09, 0.03, 20, 33, 1.0));
+    const double committed = drift ? 1.0 / (0.09 * 0.09 - 0.03 * 0.03) : 1.0 / (0.015 * 0.015);
+    EXPECT_NEAR(f.correction(), -0.09 * fresh / (committed + fresh), 1e-12);  // -0.080 (without matching -0.064)
+    EXPECT_NEAR(f.sigma(), 1.0 / std::sqrt(committed + fresh), 1e-12);
+  }
+  // A window less certain than the committed part leaves it as the drift left it, however far off it is.
+  ScaleFilter f;
+  EXPECT_TRUE(f.add(0.0, 0.015, 0, 13, 0.0));
+  f.setDrift(0.01);
+  EXPECT_TRUE(f.add(-0.3, 0.1, 20, 33, 1.0));
+  const double committed = 1.0 / var_faded, uncertain = 1.0 / (0.1 * 0.1);
+  EXPECT_NEAR(f.correction(), -0.3 * uncertain / (committed + uncertain), 1e-12);
 }

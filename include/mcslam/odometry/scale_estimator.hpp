@@ -119,7 +119,9 @@ class ScaleEstimator {
 // combination restarts from the latest. Windows of one turn also share their scene and the map's history:
 // rotationSpan() says over how much rotation of the rig (radians travelled, `rotation` of add()) the combined
 // estimates were gathered. With a drift set (once the odometry declared the scale), what is known of the unit
-// fades with the keyframes since: the estimates of one turn then correct the drift of the straight before it.
+// fades with the keyframes since: the estimates of one turn then correct the drift of the straight before it;
+// where a window more certain than the committed part contradicts it beyond both sigmas, the unit jumped rather
+// than drifted, and the committed part is held only as certain as the disagreement allows.
 // (Before that the combination tests whether windows of different turns agree on one unit; drift there shows
 // as disagreement, and the combination restarts.)
 class ScaleFilter {
