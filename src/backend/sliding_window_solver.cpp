@@ -90,7 +90,7 @@ SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
   SolveSummary summary;
   const int analyses_before = reduced.analyses();
   WindowLinearization& lin = linearization;
-  if (!lin.prepare(window, options.gauge_fixed_oldest)) {
+  if (!lin.prepare(window, options.gauge_fixed_oldest, options.hold_window_scale)) {
     summary.failed = true;
     classifyOutliers();
     summary.outliers = static_cast<int>(outliers.size());
@@ -233,6 +233,8 @@ Status SlidingWindowSolver::setGaugeFixedOldest(int count) {
   impl_->options.gauge_fixed_oldest = count;
   return Status::Ok;
 }
+void SlidingWindowSolver::setHoldWindowScale(bool hold) { impl_->options.hold_window_scale = hold; }
+
 Status SlidingWindowSolver::setKeyframePose(int64_t id, const SE3& T_w_b) {
   const int s = impl_->window.keyframeSlot(id);
   if (s < 0) return Status::UnknownKeyframe;

@@ -58,13 +58,40 @@ WindowLinearization::WindowLinearization(const WindowStorage& window, const Solv
   touched_.resize(max_blocks_);
   touched_slot_.assign(max_blocks_, -1);
   kf_trial_.resize(cap.max_keyframes);
+  held_slots_.resize(cap.max_keyframes);
+  scale_J_.resize(cap.max_keyframes);
   ext_trial_.resize(num_cameras_);
   ext_d_trial_.resize(num_cameras_);
 }
 
-bool WindowLinearization::prepare(const WindowStorage& window, int fixed_oldest) {
+bool WindowLinearization::prepare(const WindowStorage& window, int fixed_oldest, bool hold_scale) {
   // Gauge: the oldest keyframes (and those the caller fixed) are held fixed. -2 marks fixed.
   const int K = static_cast<int>(window.keyframes.size());
+  hold_scale_ = false;
+  if (hold_scale) {
+    // The unit from every keyframe between the oldest and the newest (the newest is the tracked one: its
+    // distance is what the solve is to find); fewer than three keyframes: the two oldest hold it.
+    int oldest = -1, newest = -1;
+    for (int s = 0; s < K; ++s) {
+      const KeyframeState& kf = window.keyframes[s];
+      if (!kf.used) continue;
+      if (oldest < 0 || kf.sequence < window.keyframes[oldest].sequence) oldest = s;
+      if (newest < 0 || kf.sequence > window.keyframes[newest].sequence) newest = s;
+    }
+    num_held_ = 0;
+    for (int s = 0; oldest >= 0 && s < K; ++s) {
+      if (window.keyframes[s].used && s != oldest && s != newest) held_slots_[num_held_++] = s;
+    }
+    scale_anchor_ = oldest;
+    const double d = num_held_ > 0 ? heldDistance(window, false) : 0;
+    hold_scale_ = d > 0 && std::isfinite(d);
+    if (hold_scale_) {
+      log_held_distance_ = std::log(d);
+      fixed_oldest = std::max(fixed_oldest, 1);
+    } else {
+      fixed_oldest = std::max(fixed_oldest, 2);
+    }
+  }
   std::fill(pose_block_.begin(), pose_block_.end(), -1);
   for (int i = 0; i < fixed_oldest; ++i) {
     int oldest = -1;
@@ -190,13 +217,40 @@ void WindowLinearization::linearize(const WindowStorage& window, const Marginali
     prior_r_[c] = extrinsicPriorResidual(e.T_calib, e.T, options_.extrinsic_prior, use_fej_[c] ? &e.T_lin : nullptr,
                                          &prior_J_[c]);
   }
+  if (hold_scale_) {
+    // d r / d rho_s = (t_s - t_a)^T R_s / (|t_s - t_a| D sigma): T_w_b exp(xi) moves t by R rho.
+    const Vec3& anchor = window.keyframes[scale_anchor_].T_w_b.t;
+    const double d = heldDistance(window, false);
+    scale_r_ = scaleResidual(window, false);
+    for (int i = 0; i < num_held_; ++i) {
+      const KeyframeState& kf = window.keyframes[held_slots_[i]];
+      const Vec3 v = kf.T_w_b.t - anchor;
+      const double n = v.norm();
+      scale_J_[i].setZero();
+      if (n > 0) scale_J_[i].head<3>() = kf.T_w_b.R.transpose() * v / (n * d * kScaleSigma);
+    }
+  }
   cost_ = cost + priorCost(window, prior, false);
   d_current_ = d_eval_;
+}
+
+double WindowLinearization::heldDistance(const WindowStorage& window, bool trial) const {
+  const Vec3& anchor = window.keyframes[scale_anchor_].T_w_b.t;  // held fixed: the same in a trial
+  double d = 0;
+  for (int i = 0; i < num_held_; ++i) {
+    const int s = held_slots_[i];
+    d += ((trial ? kf_trial_[s].t : window.keyframes[s].T_w_b.t) - anchor).norm();
+  }
+  return d;
 }
 
 double WindowLinearization::priorCost(const WindowStorage& window, const MarginalizationPrior& prior,
                                       bool trial) const {
   double cost = 0;
+  if (hold_scale_) {
+    const double r = scaleResidual(window, trial);
+    cost += 0.5 * r * r;
+  }
   for (int c = 0; c < num_cameras_; ++c) {
     const ExtrinsicState& e = window.extrinsics[c];
     if (!e.variable || !e.calibration_prior) continue;
@@ -261,6 +315,20 @@ void WindowLinearization::buildReducedSystem(double mu, const MarginalizationPri
         }
       }
       D_c_.segment<6>(6 * ba) += prior.H.block<6, 6>(6 * va, 6 * va).diagonal();
+    }
+  }
+
+  // The window's unit: one residual over every held keyframe's translation.
+  for (int i = 0; hold_scale_ && i < num_held_; ++i) {
+    const int a = pose_block_[held_slots_[i]];
+    if (a < 0) continue;
+    g_c_.segment<6>(6 * a) += scale_J_[i] * scale_r_;
+    D_c_.segment<6>(6 * a) += scale_J_[i].cwiseAbs2();
+    for (int j = 0; j < num_held_; ++j) {
+      const int b = pose_block_[held_slots_[j]];
+      if (b < a) continue;
+      S_.block<6, 6>(6 * a, 6 * b).noalias() += scale_J_[i] * scale_J_[j].transpose();
+      pattern_[size_t(a) * max_blocks_ + b] = 1;
     }
   }
 

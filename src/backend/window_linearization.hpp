@@ -3,6 +3,8 @@
 // landmarks enter, the residuals and Jacobians at the current state, the damped reduced camera
 // system after eliminating the landmarks (Schur complement on 3x3 blocks), the landmark
 // back-substitution, and the cost at a trial step. Every buffer is sized at construction.
+#include <cmath>
+
 #include <Eigen/Core>
 #include <vector>
 
@@ -17,7 +19,8 @@ class WindowLinearization {
 
   // Chooses the free variables (gauge: the `fixed_oldest` oldest keyframes and those the caller fixed are
   // held) and collects the landmarks with >= 2 observations. False when there is nothing to optimize.
-  bool prepare(const WindowStorage& window, int fixed_oldest);
+  // `hold_scale`: SolverOptions::hold_window_scale (the reference distances are taken here).
+  bool prepare(const WindowStorage& window, int fixed_oldest, bool hold_scale);
   // Residuals, robust weights and Jacobians at the current state. `select_landmarks` (first call
   // of a solve) drops observations that do not project and landmarks that are not constrained.
   void linearize(const WindowStorage& window, const MarginalizationPrior& prior, bool select_landmarks);
@@ -76,6 +79,11 @@ class WindowLinearization {
 
   void updateTransforms(const WindowStorage& window);
   double priorCost(const WindowStorage& window, const MarginalizationPrior& prior, bool trial) const;
+  // Summed distances of the held keyframes from the anchor (trial poses or the window's).
+  double heldDistance(const WindowStorage& window, bool trial) const;
+  double scaleResidual(const WindowStorage& window, bool trial) const {
+    return (std::log(heldDistance(window, trial)) - log_held_distance_) / kScaleSigma;
+  }
 
   const SolverOptions options_;
   int max_blocks_;
@@ -119,6 +127,17 @@ class WindowLinearization {
   std::vector<Eigen::Matrix<double, 6, 3>> W_;  // per touched block of one landmark
   std::vector<int> touched_;
   std::vector<int> touched_slot_;
+
+  // The window's unit (hold_window_scale): anchor = oldest keyframe slot, held = the slots between it and the
+  // newest; their pose blocks and the residual's Jacobian rows (6 per block, translation part only).
+  static constexpr double kScaleSigma = 1e-4;  // of log(summed distances): stiff
+  bool hold_scale_ = false;
+  int scale_anchor_ = -1;
+  std::vector<int> held_slots_;
+  int num_held_ = 0;
+  double log_held_distance_ = 0;
+  double scale_r_ = 0;
+  std::vector<Vec6> scale_J_;  // per held slot (index into held_slots_)
 
   // Trial state.
   std::vector<SE3> kf_trial_;

@@ -106,7 +106,10 @@ void LocalMapper::rescale(double s, const Vec3& center) {
 }
 
 void LocalMapper::holdScale(bool hold) {
-  if (solver_) solver_->setGaugeFixedOldest(gaugeFixedOldest(monocular_, hold));
+  if (!solver_) return;
+  const bool by_window = hold && options_.hold_window_scale;
+  solver_->setHoldWindowScale(by_window);
+  solver_->setGaugeFixedOldest(by_window ? 1 : gaugeFixedOldest(monocular_, hold));
 }
 
 Rig LocalMapper::refinedRig() const {

@@ -246,7 +246,9 @@ void Odometry::estimateScale() {
   stats_.last_scale = e.scale;
   stats_.last_scale_sigma = e.relative_sigma;
   if (!scale_filter_->add(std::log(e.scale), e.relative_sigma, e.oldest_id, e.newest_id, rotation_travelled_)) {
-    return;  // an outlier
+    spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} dropped as an outlier", frame_index_, e.scale,
+                  e.relative_sigma);
+    return;
   }
   const double x = scale_filter_->correction(), sigma = scale_filter_->sigma();
   stats_.combined_scale_sigma = sigma;

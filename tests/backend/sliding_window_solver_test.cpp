@@ -209,6 +209,49 @@ TEST(SlidingWindowSolver, GaugeOfTheOldestKeyframesChangesAtRunTime) {
   EXPECT_GT((T.t - guess.T_w_b[1].t).norm(), 1e-3);  // free again: it moves
 }
 
+TEST(SlidingWindowSolver, HoldingTheWindowScaleKeepsTheSummedDistancesOfItsKeyframes) {
+  // The guess 10% larger than the scene about the oldest keyframe: the 5-camera rig's reprojections want the
+  // scene's unit back, the hold keeps the guess's (the summed distances from the oldest keyframe of those
+  // between it and the newest), and only the oldest keyframe is fixed.
+  SceneOptions so;
+  so.landmarks_per_keyframe = 40;
+  const Scene scene = makeScene(isecRig(), so);
+  WindowGuess guess = perturbedGuess(scene, 0.03, 0.01, 0.1, 7);
+  const Vec3 anchor = guess.T_w_b[0].t;
+  for (SE3& T : guess.T_w_b) T.t = anchor + 1.1 * (T.t - anchor);
+  for (Vec3& p : guess.points) p = anchor + 1.1 * (p - anchor);
+  const int n = static_cast<int>(guess.T_w_b.size());
+  ASSERT_GE(n, 4);
+  auto held = [&](auto pose) {
+    double d = 0;
+    for (int k = 1; k < n - 1; ++k) d += (pose(k).t - anchor).norm();
+    return d;
+  };
+  const double before = held([&](int k) { return guess.T_w_b[k]; });
+  for (const bool hold : {false, true}) {
+    SlidingWindowSolver solver(scene.rig, smallCapacity());
+    fillSolver(solver, scene, guess);
+    ASSERT_EQ(solver.setGaugeFixedOldest(1), Status::Ok);
+    solver.setHoldWindowScale(hold);
+    const SolveSummary s = solver.solve(30);
+    ASSERT_FALSE(s.failed);
+    EXPECT_LT(s.final_cost, s.initial_cost);
+    auto pose = [&](int k) {
+      SE3 T;
+      solver.keyframePose(k, T);
+      return T;
+    };
+    EXPECT_EQ(pose(0).t, anchor);
+    EXPECT_GT((pose(1).t - guess.T_w_b[1].t).norm(), 1e-3);  // free: it moves
+    const double ratio = held(pose) / before;
+    if (hold) {
+      EXPECT_NEAR(ratio, 1.0, 1e-3);
+    } else {
+      EXPECT_NEAR(ratio, 1.0 / 1.1, 0.01);  // the rig's overlap finds the scene's unit
+    }
+  }
+}
+
 TEST(SlidingWindowSolver, SymbolicAnalysisRedoneOnlyWhenStructureChanges) {
   SceneOptions so;
   so.landmarks_per_keyframe = 40;

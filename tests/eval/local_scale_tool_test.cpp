@@ -1,5 +1,5 @@
 // tools/eval/local_scale.py --span: the unit of one stretch of a run (the path the estimate travelled over the
-// true one), the figure BENCHMARKS.md gives for how a rig without overlap finishes.
+// true one), the figure BENCHMARKS.md gives for how a rig without overlap finishes; --from: the spans after a pose.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -45,4 +45,22 @@ TEST(LocalScaleTool, SpanGivesTheUnitOfOneStretchAndNamesABadSpan) {
   out = localScale(files + " --span 40 10", &code);
   EXPECT_NE(code, 0);
   EXPECT_NE(out.find("--span 40 10: needs two poses in order among the 60 matched"), std::string::npos) << out;
+}
+
+TEST(LocalScaleTool, FromCountsOnlyTheSpansAfterAPose) {
+  if (test::runCommand("python3 --version") != 0) GTEST_SKIP() << "python3 is not installed";
+  test::TempDir dir("local_scale_from");
+  writeRun(dir.file("gt.txt"), dir.file("run.tum"), 1.1);
+  const std::string files = dir.file("gt.txt") + " " + dir.file("run.tum") + " --frames 10";
+  int code = -1;
+  std::string out = localScale(files, &code);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("(50 spans)"), std::string::npos) << out;
+  out = localScale(files + " --from 30", &code);  // only the stretch at 1.1
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("(20 spans): min 1.100"), std::string::npos) << out;
+  EXPECT_NE(out.find("within 5%: 0.0% of the spans"), std::string::npos) << out;
+  out = localScale(files + " --from 55", &code);
+  EXPECT_NE(code, 0);
+  EXPECT_NE(out.find("--from 55: needs a pose more than 10 before the last of the 60 matched"), std::string::npos) << out;
 }

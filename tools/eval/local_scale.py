@@ -6,9 +6,11 @@ scale wanders along the run. Pairs whose true distance is under --min-distance a
 nothing of the scale). Poses are matched by timestamp (TUM or EuRoC ground truth, seconds or nanoseconds).
 
   tools/eval/local_scale.py DATASET/groundtruth.txt run.tum [--frames 40] [--series] [--span FIRST LAST]
+                            [--from FIRST]
 
 --span prints the unit over one stretch: the path the estimate travelled between two poses over the true path
 (indices into the matched poses, negative from the end: --span -120 -1 is how the run finishes).
+--from counts only the spans that start at that pose or later (after the scale converged, say).
 """
 import argparse
 import math
@@ -40,6 +42,8 @@ def main():
     ap.add_argument('--frames', type=int, default=40, help='distance over this many frames (default 40)')
     ap.add_argument('--min-distance', type=float, default=0.5, help='metres the truth must move (default 0.5)')
     ap.add_argument('--series', action='store_true', help='also print the local scale every 20 frames')
+    ap.add_argument('--from', dest='first', type=int, default=0, metavar='FIRST',
+                    help='only spans starting at this pose or later (default 0)')
     ap.add_argument('--span', nargs=2, type=int, metavar=('FIRST', 'LAST'),
                     help='also print the path travelled between these poses over the true one')
     a = ap.parse_args()
@@ -48,7 +52,9 @@ def main():
     if len(ts) <= a.frames:
         sys.exit(f"only {len(ts)} poses of {a.estimate} have a ground-truth pose at the same time (need > {a.frames})")
     ratios = []
-    for i in range(len(ts) - a.frames):
+    if not 0 <= a.first < len(ts) - a.frames:
+        sys.exit(f"--from {a.first}: needs a pose more than {a.frames} before the last of the {len(ts)} matched")
+    for i in range(a.first, len(ts) - a.frames):
         t0, t1 = ts[i], ts[i + a.frames]
         d_true = math.dist(gt[t0], gt[t1])
         if d_true < a.min_distance:

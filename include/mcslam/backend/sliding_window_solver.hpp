@@ -46,6 +46,12 @@ struct SolverOptions {
   bool first_estimate_jacobians = true;  // for the extrinsics linked to the marginalization prior
 
   int gauge_fixed_oldest = 1;            // oldest keyframes held fixed (2 for a monocular rig: scale)
+  // The window's unit held instead by all its keyframes: the summed distances from the oldest keyframe of
+  // those between it and the newest stay as the solve found them (a stiff residual). Two fixed keyframes tie
+  // the unit to one pair, which can be 10 cm apart (keyframes at every frame where tracking thins): a 1 cm
+  // error in it is 10% of the unit. Needs gauge_fixed_oldest >= 1; with fewer than three keyframes the two
+  // oldest are held instead.
+  bool hold_window_scale = false;
   // A landmark enters a solve with >= 2 observations and min/max eigenvalue of its 3x3
   // information at least this (parallax); otherwise it is held fixed and left out.
   double min_landmark_conditioning = 1e-9;
@@ -109,6 +115,7 @@ class SlidingWindowSolver {
   // How many oldest keyframes the next solves hold (SolverOptions::gauge_fixed_oldest): 2 holds the window's
   // scale as well, for a map whose scale the window alone cannot keep. InvalidValue below 0.
   Status setGaugeFixedOldest(int count);
+  void setHoldWindowScale(bool hold);  // SolverOptions::hold_window_scale, from the next solve
   Status setKeyframePose(int64_t id, const SE3& T_w_b);
   Status setLandmarkPosition(int64_t id, const Vec3& p_w);
   // A new current estimate of a refined camera's extrinsic T_b_c from outside (e.g. a per-camera check). The
