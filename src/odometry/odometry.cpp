@@ -328,10 +328,10 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   initialized_ = true;
   scale_converged_ = metric;
   scale_free_start_ = !metric;
-  // A map that starts up to scale keeps its unit (the window's two oldest keyframes fixed, as for one camera)
-  // and only the estimates of estimateScale() change it. A free window random-walked its scale wherever no turn
-  // constrained it: the 33 cm rig's map shrank to a tenth on a straight stretch, the 10 cm rig lost track.
-  // resetMap() lets it go with the window.
+  // A map that starts up to scale keeps its unit (the window's summed keyframe distances held, or its two oldest
+  // keyframes fixed as for one camera: OdometryOptions::hold_window_scale) and only the estimates of
+  // estimateScale() change it. A free window random-walked its scale wherever no turn constrained it: the 33 cm
+  // rig's map shrank to a tenth on a straight stretch, the 10 cm rig lost track. resetMap() lets it go.
   if (!metric && rig_.size() > 1) mapper_->holdScale(true);
   mapper_->setSceneReferencedPoints(!metric || rig_.size() == 1);
   if (scale_filter_) scale_filter_->reset();

@@ -191,3 +191,18 @@ TEST(ScaleFilter, ACertainWindowThatContradictsTheFadedPastOutweighsIt) {
   const double committed = 1.0 / var_faded, uncertain = 1.0 / (0.1 * 0.1);
   EXPECT_NEAR(f.correction(), -0.3 * uncertain / (committed + uncertain), 1e-12);
 }
+
+// Windows that overlap share their data: in a map a fast corner broke they agree with each other, however wrong.
+// Once converged, a restart needs rejected windows that include two sharing no keyframe.
+TEST(ScaleFilter, OnceConvergedARestartNeedsRejectedWindowsThatShareNoKeyframe) {
+  ScaleFilter f;
+  EXPECT_TRUE(f.add(0.0, 0.02, 0, 13, 0.0));
+  f.setDrift(0.01);
+  EXPECT_FALSE(f.add(1.0, 0.02, 14, 27, 1.0));
+  EXPECT_FALSE(f.add(1.0, 0.02, 15, 28, 1.1));
+  EXPECT_FALSE(f.add(1.0, 0.02, 16, 29, 1.2));  // the third in a row, but all share keyframes 16-27
+  EXPECT_NEAR(f.correction(), 0.0, 1e-12);
+  EXPECT_TRUE(f.add(1.0, 0.02, 28, 41, 2.0));   // none shared with the first: the scale moved
+  EXPECT_NEAR(f.correction(), 1.0, 1e-12);
+  EXPECT_NEAR(f.sigma(), 0.02, 1e-12);
+}

@@ -53,9 +53,9 @@ class LocalMapper {
   // Multiplies every keyframe position and landmark, in the map and in the back-end's window, about `center`
   // (a new metric scale). No solve may be in flight.
   void rescale(double s, const Vec3& center);
-  // Whether the back-end's window holds its scale (its two oldest keyframes fixed) instead of letting its
-  // reprojections pull it: for a map whose unit only explicit rescales may change (a rig without overlap). No
-  // solve may be in flight; reset() lets it go.
+  // Whether the back-end's window holds its scale (OdometryOptions::hold_window_scale, else its two oldest
+  // keyframes fixed) instead of letting its reprojections pull it: for a map whose unit only explicit rescales
+  // may change (a rig without overlap). No solve may be in flight; reset() lets it go.
   void holdScale(bool hold);
   Rig refinedRig() const;
   // The back-end's current estimate of camera `cam`'s extrinsic (the rig's when there is no back-end). Not while

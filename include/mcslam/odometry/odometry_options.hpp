@@ -48,12 +48,12 @@ struct OdometryOptions {
   // nothing) it is taken to random-walk by this relative sigma per keyframe. Measured on the rendered 10 cm rig:
   // 4-17% between corners 40-60 keyframes apart (tools/eval/local_scale.py measures it on any recording).
   double scale_drift_per_keyframe = 0.01;
-  // A map whose unit is held (no overlap) holds it by all the back-end window's keyframes instead of its two
-  // oldest (backend::SolverOptions::hold_window_scale). Off: on the rendered 10 cm rig the unit then holds along
-  // the blank-walled corridors (30-frame spans after convergence within 5%: 78% against 61%, seven runs) but
-  // the SE(3) ATE was worse (1.95 m against 1.71 mean; 1.55 against 0.90 m on the seed-2 render), a corner's
-  // change of unit being held as firmly as a right one (BENCHMARKS.md, "7d").
-  bool hold_window_scale = false;
+  // A map whose unit is held (no overlap) holds it by all the back-end window's keyframes, not by its two oldest
+  // (backend::SolverOptions::hold_window_scale): a pair can be 10 cm apart, and where both side cameras of the
+  // rendered 10 cm rig face blank walls the unit grew 14% in 20 keyframes through it. With it, seven runs: SE(3)
+  // ATE after convergence 0.13 m mean against 0.31, last 120 frames within 5% in 7 of 7 against 6 (BENCHMARKS.md,
+  // "7d"); what it cannot undo is a unit a fast corner's tracking gave the map, which it then keeps.
+  bool hold_window_scale = true;
 
   // Mapping.
   // Multi-view points become landmarks below this relative depth sigma: the same bar as points triangulated

@@ -163,6 +163,7 @@ class ScaleFilter {
   int64_t last_newest_ = -1;     // newest keyframe id of any window added
   double drift_variance_ = 0;    // per keyframe
   int rejected_ = 0;
+  int64_t first_rejected_newest_ = -1;  // newest keyframe id of the first window of the rejected run
   double first_rotation_ = 0, last_rotation_ = 0;
 };
 
