@@ -353,7 +353,7 @@ bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t
   if (info() > 0 && (log_scale - x) * (log_scale - x) > 9.0 * (sigma * sigma + 1.0 / info())) {
     // One window off by 3 sigma is an outlier; several in a row mean the map's scale moved. Once converged,
     // they must include two that share no keyframe: overlapping windows in a map a fast corner broke agree with
-    // each other (three at 0.79 +- 4% restarted the combination where the truth wanted 1.25).
+    // each other (three at 0.79 +- 4% restarted the combination the wrong way: the map had shrunk).
     if (rejected_++ == 0) first_rejected_newest_ = newest_id;
     const bool independent = drift_variance_ == 0 || oldest_id > first_rejected_newest_;
     if (rejected_ < kRestartAfter || !independent) return false;
