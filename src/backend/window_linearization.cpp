@@ -221,7 +221,7 @@ void WindowLinearization::linearize(const WindowStorage& window, const Marginali
     // d r / d rho_s = (t_s - t_a)^T R_s / (|t_s - t_a| D sigma): T_w_b exp(xi) moves t by R rho.
     const Vec3& anchor = window.keyframes[scale_anchor_].T_w_b.t;
     const double d = heldDistance(window, false);
-    scale_r_ = scaleResidual(window, false);
+    scale_r_ = scaleResidual(d);
     for (int i = 0; i < num_held_; ++i) {
       const KeyframeState& kf = window.keyframes[held_slots_[i]];
       const Vec3 v = kf.T_w_b.t - anchor;
@@ -248,7 +248,7 @@ double WindowLinearization::priorCost(const WindowStorage& window, const Margina
                                       bool trial) const {
   double cost = 0;
   if (hold_scale_) {
-    const double r = scaleResidual(window, trial);
+    const double r = scaleResidual(heldDistance(window, trial));
     cost += 0.5 * r * r;
   }
   for (int c = 0; c < num_cameras_; ++c) {

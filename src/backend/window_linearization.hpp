@@ -81,8 +81,8 @@ class WindowLinearization {
   double priorCost(const WindowStorage& window, const MarginalizationPrior& prior, bool trial) const;
   // Summed distances of the held keyframes from the anchor (trial poses or the window's).
   double heldDistance(const WindowStorage& window, bool trial) const;
-  double scaleResidual(const WindowStorage& window, bool trial) const {
-    return (std::log(heldDistance(window, trial)) - log_held_distance_) / kScaleSigma;
+  double scaleResidual(double held_distance) const {
+    return (std::log(held_distance) - log_held_distance_) / kScaleSigma;
   }
 
   const SolverOptions options_;
