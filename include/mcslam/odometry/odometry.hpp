@@ -13,8 +13,8 @@
 #include "mcslam/geometry/pose_refinement.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
+#include "mcslam/odometry/pose_estimate.hpp"
 #include "mcslam/odometry/projection_search.hpp"
-#include "mcslam/pipeline/frame_processor.hpp"
 
 namespace mcslam {
 

@@ -8,23 +8,9 @@
 #include "mcslam/core/image.hpp"
 #include "mcslam/core/se3.hpp"
 #include "mcslam/core/time.hpp"
+#include "mcslam/odometry/pose_estimate.hpp"
 
 namespace mcslam {
-
-enum class TrackingState : uint8_t {
-  NotInitialized = 0,  // no map yet (waiting for enough features or parallax)
-  Tracking = 1,        // pose estimated against the map
-  Lost = 2,            // tracking failed on this frame; the pipeline re-initializes and goes on
-};
-
-inline const char* trackingStateName(TrackingState s) {
-  switch (s) {
-    case TrackingState::NotInitialized: return "not_initialized";
-    case TrackingState::Tracking: return "tracking";
-    case TrackingState::Lost: return "lost";
-  }
-  return "?";
-}
 
 // One synchronized capture of the rig. images[c] is valid when present[c] is true.
 struct RigFrameView {
@@ -33,19 +19,6 @@ struct RigFrameView {
   int cameras = 0;
   const ImageView* images = nullptr;
   const bool* present = nullptr;
-};
-
-struct PoseEstimate {
-  Timestamp t = 0;           // capture time of the frame, ns
-  uint64_t sequence = 0;
-  SE3 T_w_b;                 // body in world (world = body at the first frame)
-  TrackingState state = TrackingState::NotInitialized;
-  float quality = 0;         // 0..1: share of expected landmark matches that were inliers
-  bool is_keyframe = false;
-  bool valid = false;        // T_w_b holds an estimate
-  // T_w_b.t is in metres. False when its unit is arbitrary: one camera, or a rig without overlap whose map
-  // started up to scale and has not yet found it.
-  bool metric = true;
 };
 
 class FrameProcessor {
