@@ -7,7 +7,7 @@
 #include <mutex>
 #include <tuple>
 
-#include "thread_pool.hpp"
+#include "mcslam/core/worker_pool.hpp"
 
 namespace mcslam::sim {
 
@@ -15,13 +15,13 @@ namespace {
 
 using Key = std::tuple<int, int, double, double, double, double, int, std::array<double, 4>, int>;
 
-std::shared_ptr<const CameraLut> compute(const CameraModel& m, int tile, ThreadPool& pool) {
+std::shared_ptr<const CameraLut> compute(const CameraModel& m, int tile, WorkerPool& pool) {
   auto lut = std::make_shared<CameraLut>();
   const int W = m.width(), H = m.height();
   lut->layout(W, H, tile);
   std::vector<Vec3> bearing(static_cast<std::size_t>(W) * H, Vec3::Zero());
   std::vector<uint8_t> ok(static_cast<std::size_t>(W) * H, 0);
-  pool.run(H, [&](int y) {
+  pool.forEach(H, [&](int y) {
     for (int x = 0; x < W; ++x) {
       Vec3 b;
       const std::size_t i = static_cast<std::size_t>(y) * W + x;
@@ -32,7 +32,7 @@ std::shared_ptr<const CameraLut> compute(const CameraModel& m, int tile, ThreadP
     }
   });
   // Angular pixel size from the neighbours (one-sided at the borders).
-  pool.run(H, [&](int y) {
+  pool.forEach(H, [&](int y) {
     for (int x = 0; x < W; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * W + x;
       if (!ok[i]) continue;
@@ -134,7 +134,7 @@ void CameraLut::layout(int w, int h, int tile_size) {
   for (int x = 0; x < w; ++x) col_offset_[x] = x / ts * ts * ts + x % ts;
 }
 
-std::shared_ptr<const CameraLut> CameraLut::get(const CameraModel& m, int tile, ThreadPool& pool) {
+std::shared_ptr<const CameraLut> CameraLut::get(const CameraModel& m, int tile, WorkerPool& pool) {
   static std::mutex mutex;
   static std::map<Key, std::weak_ptr<const CameraLut>> cache;
   const Key key{m.width(), m.height(), m.fx(), m.fy(), m.cx(), m.cy(), static_cast<int>(m.distortion()), m.coeffs(), tile};

@@ -8,9 +8,11 @@
 
 #include "mcslam/calib/camera_model.hpp"
 
-namespace mcslam::sim {
+namespace mcslam {
+class WorkerPool;
+}
 
-class ThreadPool;
+namespace mcslam::sim {
 
 struct CameraLut {
   struct Tile {
@@ -36,7 +38,7 @@ struct CameraLut {
   // Sets the sizes and the tile layout (before the rays are filled in).
   void layout(int w, int h, int tile_size);
 
-  static std::shared_ptr<const CameraLut> get(const CameraModel& model, int tile, ThreadPool& pool);
+  static std::shared_ptr<const CameraLut> get(const CameraModel& model, int tile, WorkerPool& pool);
 
  private:
   std::size_t index(int x, int y) const { return 4 * (static_cast<std::size_t>(row_start_[y]) + col_offset_[x]); }

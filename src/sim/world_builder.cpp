@@ -6,7 +6,7 @@
 #include "lightmap_baker.hpp"
 #include "mcslam/core/error.hpp"
 #include "texture_library.hpp"
-#include "thread_pool.hpp"
+#include "sim_pool.hpp"
 #include "world_data.hpp"
 
 namespace mcslam::sim {
@@ -185,7 +185,7 @@ std::shared_ptr<const World> WorldBuilder::build() {
   if (!data_) throw std::logic_error("WorldBuilder::build called twice");
   WorldData& d = *data_;
   TextureLibrary library(seed_, textures_dir_);
-  ThreadPool pool(0);
+  WorkerPool pool(poolWorkers(0));
 
   // Which object owns each face (fitted textures are unique per object), and the face's size.
   const std::size_t n_faces = d.face_materials.size();
