@@ -252,8 +252,8 @@ void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool e
 
 namespace {
 
-// Runs fn over the tiles in runs of neighbours: threads taking alternate tiles wrote to the same cache lines (a
-// tile's 16 bytes of an image row, the headers of neighbouring candidate lists) and bounced them between cores.
+// Runs fn over the tiles in runs of neighbours: threads taking alternate tiles would write to the same cache lines
+// (a tile's 16 bytes of an image row, the headers of neighbouring candidate lists) and bounce them between cores.
 template <class Fn>
 void runTiles(WorkerPool& pool, int tiles, const Fn& fn) {
   constexpr int kRun = 4;
