@@ -198,48 +198,53 @@ Vec2 informationCentroid(const AlignmentTemplate& t) {
   return t.axis * (t.spacing * along / weight);
 }
 
-EpipolarAlignment alignAlongEpipolar(const AlignmentTemplate& t, const ImageView& image, const Vec2& uv0,
-                                     const Vec2& direction, const Mat2& A, double partner_spacing,
-                                     const EpipolarAlignmentOptions& options) {
-  EpipolarAlignment out;
-  out.uv = uv0;
-  const double det = A.determinant();
-  if (!t.ok || image.empty() || !(std::abs(det) > 1e-6) || !A.allFinite()) return out;
-  const int h = t.half, n = t.samples, padded = t.padded;
-  const double spacing = t.spacing;
-  const double max_shift = options.max_shift_spacings * (spacing + partner_spacing);
-  const double ex = spacing * h * (std::abs(A(0, 0)) + std::abs(A(0, 1))) + max_shift + 1;
-  const double ey = spacing * h * (std::abs(A(1, 0)) + std::abs(A(1, 1))) + max_shift + 1;
-  if (!inside(image, uv0.x(), uv0.y(), ex, ey)) return out;
+namespace {
 
+// The template as the partner sees it: its derivative along the shift and its samples' offsets in the partner
+// image, with the Gauss-Newton information along the shift.
+struct PartnerWarp {
+  alignas(16) float grad[kMaxPadded];
+  alignas(16) float off_x[kMaxPadded];
+  alignas(16) float off_y[kMaxPadded];
+  double hessian = 0, grad_dot_tmpl = 0;
+};
+
+void warpTemplate(const AlignmentTemplate& t, const Vec2& direction, const Mat2& A, PartnerWarp& pw) {
+  const int h = t.half, padded = t.padded;
+  const double spacing = t.spacing;
   // A shift s along the direction in the partner moves the reference grid by s * w: the template's derivative
   // along the shift is its gradient along w (zero mean, as the gradients are).
   const Vec2 w = A.inverse() * direction;
   const float wx = static_cast<float>(w.x()), wy = static_cast<float>(w.y());
-  alignas(16) float grad[kMaxPadded], off_x[kMaxPadded], off_y[kMaxPadded];
-  alignas(16) float xs[kMaxPadded], ys[kMaxPadded], values[kMaxPadded];
-  for (int k = 0; k < padded; ++k) grad[k] = t.dx[k] * wx + t.dy[k] * wy;  // padding: zero
+  for (int k = 0; k < padded; ++k) pw.grad[k] = t.dx[k] * wx + t.dy[k] * wy;  // padding: zero
   const Vec2 step_i = A.col(0) * spacing, step_j = A.col(1) * spacing;
   int k = 0;
   for (int j = -h; j <= h; ++j) {
     for (int i = -h; i <= h; ++i, ++k) {
-      off_x[k] = static_cast<float>(step_i.x() * i + step_j.x() * j);
-      off_y[k] = static_cast<float>(step_i.y() * i + step_j.y() * j);
+      pw.off_x[k] = static_cast<float>(step_i.x() * i + step_j.x() * j);
+      pw.off_y[k] = static_cast<float>(step_i.y() * i + step_j.y() * j);
     }
   }
-  for (; k < padded; ++k) off_x[k] = off_y[k] = 0;  // padding: the centre
-  const Sums gs = dot3(grad, t.value, t.value, padded);
-  const double hessian = gs.s[0], grad_dot_tmpl = gs.s[1];
-  if (!(hessian > 1e-12)) return out;
+  for (; k < padded; ++k) pw.off_x[k] = pw.off_y[k] = 0;  // padding: the centre
+  const Sums gs = dot3(pw.grad, t.value, t.value, padded);
+  pw.hessian = gs.s[0];
+  pw.grad_dot_tmpl = gs.s[1];
+}
 
-  double s = 0, zncc = 0, residual2 = 0;
+enum class ShiftOutcome { Converged, NotConverged, NoTexture, TooFar };
+
+// The shift along the direction that aligns the partner's patch to the template (ZNCC residual), from 0.
+ShiftOutcome iterateShift(const AlignmentTemplate& t, const PartnerWarp& pw, const ImageView& image, const Vec2& uv0,
+                          const Vec2& direction, double max_shift, const EpipolarAlignmentOptions& options,
+                          double& s, double& zncc, double& residual2) {
+  const int n = t.samples, padded = t.padded;
+  alignas(16) float xs[kMaxPadded], ys[kMaxPadded], values[kMaxPadded];
   double previous_s = 0, previous_b = 0;
-  bool converged = false;
   for (int it = 0; it < options.max_iterations; ++it) {
     const float cx = static_cast<float>(uv0.x() + s * direction.x()), cy = static_cast<float>(uv0.y() + s * direction.y());
     for (int k = 0; k < padded; ++k) {
-      xs[k] = cx + off_x[k];
-      ys[k] = cy + off_y[k];
+      xs[k] = cx + pw.off_x[k];
+      ys[k] = cy + pw.off_y[k];
     }
     sampleBilinear(image, xs, ys, padded, values);
     for (int k = n; k < padded; ++k) values[k] = 0;
@@ -247,43 +252,66 @@ EpipolarAlignment alignAlongEpipolar(const AlignmentTemplate& t, const ImageView
     for (int k = 0; k < n; ++k) values[k] -= mean;
     // With both patches zero mean, and the template and its derivative too: the correlation and the residual's
     // derivative need only the partner's norm and two dot products.
-    const Sums vs = dot3(values, t.value, grad, padded);
+    const Sums vs = dot3(values, t.value, pw.grad, padded);
     const double var = vs.s[0];
-    if (!(var > 1e-6)) return out;
+    if (!(var > 1e-6)) return ShiftOutcome::NoTexture;
     const double inv_norm = 1.0 / std::sqrt(var);
     const double cross = vs.s[1] * inv_norm;
-    const double b = vs.s[2] * inv_norm - grad_dot_tmpl;
+    const double b = vs.s[2] * inv_norm - pw.grad_dot_tmpl;
     zncc = cross;
     residual2 = std::max(0.0, 2.0 - 2.0 * cross);  // both unit norm
     // Gauss-Newton's step uses the template's derivative, which the partner's image (other sampling, other
-    // blur) only approximates: convergence is linear. From the second step on, the secant of the measured
+    // blur) only approximates: convergence is linear. From the second step on, the secant of the observed
     // gradient replaces it where it is plausible (superlinear, same fixed point).
-    double step = b / hessian;
+    double step = b / pw.hessian;
     if (it > 0 && s != previous_s) {
       const double slope = (b - previous_b) / (s - previous_s);
-      if (slope > 0.2 * hessian && slope < 5 * hessian) step = b / slope;
+      if (slope > 0.2 * pw.hessian && slope < 5 * pw.hessian) step = b / slope;
     }
     previous_s = s;
     previous_b = b;
     s -= step;
-    if (!(std::abs(s) <= max_shift)) {
-      out.status = AlignmentStatus::Disagrees;
-      return out;
-    }
-    if (std::abs(step) < options.converged_px) {
-      converged = true;
-      break;
-    }
+    if (!(std::abs(s) <= max_shift)) return ShiftOutcome::TooFar;
+    if (std::abs(step) < options.converged_px) return ShiftOutcome::Converged;
+  }
+  return ShiftOutcome::NotConverged;
+}
+
+}  // namespace
+
+EpipolarAlignment alignAlongEpipolar(const AlignmentTemplate& t, const ImageView& image, const Vec2& uv0,
+                                     const Vec2& direction, const Mat2& A, double partner_spacing,
+                                     const EpipolarAlignmentOptions& options) {
+  EpipolarAlignment out;
+  out.uv = uv0;
+  const double det = A.determinant();
+  if (!t.ok || image.empty() || !(std::abs(det) > 1e-6) || !A.allFinite()) return out;
+  const int h = t.half, n = t.samples;
+  const double spacing = t.spacing;
+  const double max_shift = options.max_shift_spacings * (spacing + partner_spacing);
+  const double ex = spacing * h * (std::abs(A(0, 0)) + std::abs(A(0, 1))) + max_shift + 1;
+  const double ey = spacing * h * (std::abs(A(1, 0)) + std::abs(A(1, 1))) + max_shift + 1;
+  if (!inside(image, uv0.x(), uv0.y(), ex, ey)) return out;
+
+  PartnerWarp pw;
+  warpTemplate(t, direction, A, pw);
+  if (!(pw.hessian > 1e-12)) return out;
+  double s = 0, zncc = 0, residual2 = 0;
+  const ShiftOutcome outcome = iterateShift(t, pw, image, uv0, direction, max_shift, options, s, zncc, residual2);
+  if (outcome == ShiftOutcome::NoTexture) return out;
+  if (outcome == ShiftOutcome::TooFar) {
+    out.status = AlignmentStatus::Disagrees;
+    return out;
   }
   out.uv = uv0 + s * direction;
   out.shift = s;
   out.zncc = zncc;
-  if (!converged || zncc < options.min_zncc) {
+  if (outcome != ShiftOutcome::Converged || zncc < options.min_zncc) {
     out.status = AlignmentStatus::Disagrees;
     return out;
   }
   // Residual variance per sample (three parameters: shift, gain, bias) over the information along the direction.
-  const double sigma2 = residual2 / std::max(1, n - 3) / hessian;
+  const double sigma2 = residual2 / std::max(1, n - 3) / pw.hessian;
   const double floor = options.sigma_floor_spacings * spacing;
   out.sigma_px = std::sqrt(sigma2 + floor * floor);
   out.status = AlignmentStatus::Ok;

@@ -7,72 +7,51 @@
 
 namespace mcslam {
 
+namespace {
+// threads <= 0: one per camera up to the cores; never more than the cameras (a thread without one would only wait).
+int workerCount(int threads, int cameras) {
+  if (threads <= 0) threads = std::min(cameras, WorkerPool::hardwareThreads());
+  return std::max(0, std::min(threads, cameras));
+}
+}  // namespace
+
 FeatureWorkers::FeatureWorkers(const OrbOptions& options, const std::vector<ImageSize>& max_sizes, int threads)
-    : max_sizes_(max_sizes) {
+    : max_sizes_(max_sizes), pool_(workerCount(threads, static_cast<int>(max_sizes.size()))) {
   if (max_sizes.empty()) throw InputError("FeatureWorkers: cameras = 0: at least one camera is needed");
   ImageSize largest;
   for (const ImageSize& size : max_sizes) {
     largest.width = std::max(largest.width, size.width);
     largest.height = std::max(largest.height, size.height);
   }
-  if (threads <= 0) {
-    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    threads = std::min(cameras(), cores);
-  }
-  threads = std::min(threads, cameras());  // a thread without a camera would only wait
   done_.assign(static_cast<size_t>(cameras()), 0);
-  extractors_.reserve(static_cast<size_t>(threads));
-  for (int i = 0; i < threads; ++i) extractors_.emplace_back(options, largest.width, largest.height);
-  threads_.reserve(static_cast<size_t>(threads));
-  for (int i = 0; i < threads; ++i) threads_.emplace_back([this, i] { run(i); });
-}
-
-FeatureWorkers::~FeatureWorkers() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
-  }
-  work_ready_.notify_all();
-  for (std::thread& t : threads_) t.join();
+  extractors_.reserve(static_cast<size_t>(pool_.threads()));
+  for (int i = 0; i < pool_.threads(); ++i) extractors_.emplace_back(options, largest.width, largest.height);
 }
 
 void FeatureWorkers::setFollowUp(ExtractionFollowUp* follow_up) {
-  std::lock_guard<std::mutex> lock(mutex_);
   follow_up_ = follow_up;
   tasks_ = follow_up != nullptr ? follow_up->taskCount() : 0;
   taken_.assign(static_cast<size_t>(tasks_), 0);
 }
 
 void FeatureWorkers::extract(const ImageView* images, const bool* present, FeatureSet* out, OrbStatus* status) {
-  std::unique_lock<std::mutex> lock(mutex_);
   images_ = images;
   present_ = present;
   out_ = out;
   status_ = status;
-  next_camera_ = 0;
   std::fill(done_.begin(), done_.end(), 0);
   std::fill(taken_.begin(), taken_.end(), 0);
-  untaken_tasks_ = tasks_;
-  remaining_ = cameras() + tasks_;
-  ++frame_;
-  work_ready_.notify_all();
-  work_done_.wait(lock, [this] { return remaining_ == 0; });
+  pool_.submit(frame_job_, cameras() + tasks_);
+  pool_.wait();
 }
 
 void FeatureWorkers::runTasks(WorkerTasks& tasks) {
-  std::unique_lock<std::mutex> lock(mutex_);
   const int count = tasks.taskCount();
   if (count <= 0) return;
-  batch_ = &tasks;
-  batch_next_ = 0;
-  batch_count_ = count;
-  next_camera_ = cameras();  // no camera to extract, no follow-up task
-  untaken_tasks_ = 0;
-  remaining_ = count;
-  ++frame_;
-  work_ready_.notify_all();
-  work_done_.wait(lock, [this] { return remaining_ == 0; });
-  batch_ = nullptr;
+  batch_job_.tasks = &tasks;
+  pool_.submit(batch_job_, count);
+  pool_.wait();
+  batch_job_.tasks = nullptr;
 }
 
 void FeatureWorkers::processCamera(int camera, OrbExtractor& extractor) {
@@ -91,44 +70,25 @@ void FeatureWorkers::processCamera(int camera, OrbExtractor& extractor) {
   if (status_ != nullptr) status_[camera] = result;
 }
 
-void FeatureWorkers::run(int thread) {
-  OrbExtractor& extractor = extractors_[static_cast<size_t>(thread)];
-  uint64_t seen = 0;
-  std::unique_lock<std::mutex> lock(mutex_);
-  while (true) {
-    work_ready_.wait(lock, [&] { return stopping_ || frame_ != seen; });
-    if (stopping_) return;
-    seen = frame_;
-    // Cameras first (the tasks wait for them), then the tasks whose cameras are done; work outside the lock.
-    while (true) {
-      if (next_camera_ < cameras()) {
-        const int camera = next_camera_++;
-        lock.unlock();
-        processCamera(camera, extractor);
-        if (follow_up_ != nullptr) follow_up_->afterCamera(camera);
-        lock.lock();
-        done_[static_cast<size_t>(camera)] = 1;
-        camera_done_.notify_all();
-      } else if (untaken_tasks_ > 0) {
-        const int task = takeReadyTask();
-        if (task < 0) {  // its cameras are being extracted by other threads
-          camera_done_.wait(lock);
-          continue;
-        }
-        lock.unlock();
-        follow_up_->runTask(task, thread);
-        lock.lock();
-      } else if (batch_ != nullptr && batch_next_ < batch_count_) {
-        const int task = batch_next_++;
-        lock.unlock();
-        batch_->runTask(task, thread);
-        lock.lock();
-      } else {
-        break;
-      }
-      if (--remaining_ == 0) work_done_.notify_one();
+void FeatureWorkers::runFrameTask(int task, int thread) {
+  if (task < cameras()) {
+    processCamera(task, extractors_[static_cast<size_t>(thread)]);
+    if (follow_up_ == nullptr) return;
+    follow_up_->afterCamera(task);
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_[static_cast<size_t>(task)] = 1;
     }
+    camera_done_.notify_all();
+    return;
   }
+  // A follow-up task: whichever is ready first (the pool counts them, the order is ours).
+  int ready = -1;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    camera_done_.wait(lock, [&] { return (ready = takeReadyTask()) >= 0; });
+  }
+  follow_up_->runTask(ready, thread);
 }
 
 int FeatureWorkers::takeReadyTask() {
@@ -137,7 +97,6 @@ int FeatureWorkers::takeReadyTask() {
     const auto [a, b] = follow_up_->taskCameras(t);
     if (!done_[static_cast<size_t>(a)] || !done_[static_cast<size_t>(b)]) continue;
     taken_[static_cast<size_t>(t)] = 1;
-    --untaken_tasks_;
     return t;
   }
   return -1;

@@ -64,8 +64,8 @@ void rotatePattern(RotatedPattern& rotated) {
 void generateBriefPattern(PatternPoint (&a)[kTests], PatternPoint (&b)[kTests]) {
   // Both points i.i.d. from a wide Gaussian (sigma = 2 r) truncated to the disc of radius r, so that
   // any rotation stays within the patch: close to uniform over the disc, slightly denser at the centre.
-  // BRIEF's sigma = patch / 5 packs the tests near the centre, where they are correlated; on rotated
-  // and rescaled view pairs the wide pattern gave about 15% more correct matches. Pairs closer than
+  // BRIEF's sigma = patch / 5 packs the tests near the centre, where they are correlated, so its bits tell
+  // rotated and rescaled views apart less well (docs/benchmarks/orb.md). Pairs closer than
   // 2 pixels compare nearly the same smoothed value and mostly encode noise: drawn again.
   constexpr double kSigma = 2.0 * kPatchRadius;
   constexpr double kMaxRadius2 = kPatchRadius * kPatchRadius;

@@ -2,9 +2,8 @@
 // Spreads the chosen corners over the image by a minimum spacing, strongest first.
 //
 // Why not ORB-SLAM's "best corner of each grid cell": the cells are fixed in the image, so when the
-// view rotates or zooms they cut the scene differently and each view keeps different corners; on our
-// homography pairs that cost about a quarter of the correct matches against cv::ORB's global ranking.
-// A minimum spacing depends only on distances, so it picks the same corners in both views (up to the
+// view rotates or zooms they cut the scene differently and each view keeps different corners, which then
+// have no partner in the other view (docs/benchmarks/orb.md). A minimum spacing depends only on distances, so it picks the same corners in both views (up to the
 // budget's edge), while still keeping features away from each other.
 #include <span>
 #include <vector>

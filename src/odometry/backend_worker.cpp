@@ -4,51 +4,26 @@
 
 namespace mcslam {
 
-BackendWorker::BackendWorker() : thread_([this] { run(); }) {}
+BackendWorker::BackendWorker() = default;
 
-BackendWorker::~BackendWorker() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-  }
-  cv_.notify_all();
-  thread_.join();
-}
+BackendWorker::~BackendWorker() = default;  // the pool lets a solve in flight finish
 
 void BackendWorker::start(backend::SlidingWindowSolver& solver, int iterations) {
-  wait();  // one solve at a time
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    solver_ = &solver;
-    iterations_ = iterations;
-    pending_ = true;
-  }
-  cv_.notify_all();
+  pool_.wait();  // one solve at a time
+  solve_.solver = &solver;
+  solve_.iterations = iterations;
+  pool_.submit(solve_, 1);
 }
 
 backend::SolveSummary BackendWorker::wait() const {
-  std::unique_lock<std::mutex> lock(mutex_);
-  cv_.wait(lock, [this] { return !pending_; });
-  return summary_;
+  pool_.wait();
+  return solve_.summary;
 }
 
-void BackendWorker::run() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  for (;;) {
-    cv_.wait(lock, [this] { return pending_ || stop_; });
-    if (stop_) return;
-    backend::SlidingWindowSolver& solver = *solver_;
-    const int iterations = iterations_;
-    lock.unlock();
-    const uint64_t allocations_before = alloc::threadCount();
-    const backend::SolveSummary summary = solver.solve(iterations);
-    const uint64_t allocated = alloc::threadCount() - allocations_before;
-    lock.lock();
-    summary_ = summary;
-    allocations_ += allocated;
-    pending_ = false;
-    cv_.notify_all();
-  }
+void BackendWorker::SolveJob::run(int /*task*/, int /*thread*/) {
+  const uint64_t allocations_before = alloc::threadCount();
+  summary = solver->solve(iterations);
+  allocations += alloc::threadCount() - allocations_before;
 }
 
 }  // namespace mcslam

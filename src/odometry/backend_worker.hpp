@@ -2,11 +2,10 @@
 // The sliding-window solve on a thread of its own (the paper's local mapping runs beside tracking): the
 // tracking thread hands over a prepared window and goes on with the next frame; it collects the result at a
 // fixed point (before it touches the map again), so the output does not depend on thread timing.
-#include <condition_variable>
-#include <mutex>
-#include <thread>
+#include <cstdint>
 
 #include "mcslam/backend/sliding_window_solver.hpp"
+#include "mcslam/core/worker_pool.hpp"
 
 namespace mcslam {
 
@@ -21,20 +20,20 @@ class BackendWorker {
   void start(backend::SlidingWindowSolver& solver, int iterations);
   // Blocks until the solve started last has finished (at once when none runs) and returns its summary.
   backend::SolveSummary wait() const;
-  uint64_t allocations() const { return allocations_; }       // by this thread, all solves (after wait())
+  uint64_t allocations() const { return solve_.allocations; }  // by this thread, all solves (after wait())
 
  private:
-  void run();
-
-  mutable std::mutex mutex_;
-  mutable std::condition_variable cv_;
-  backend::SlidingWindowSolver* solver_ = nullptr;
-  int iterations_ = 0;
-  bool pending_ = false;  // a solve was started and has not finished
-  bool stop_ = false;
-  backend::SolveSummary summary_;
-  uint64_t allocations_ = 0;
-  std::thread thread_;  // last: starts once the members above exist
+  // One solve as a batch of one task on the pool's single thread; its fields are written by start() and by
+  // the task, never both at once (start() waits for the previous solve first).
+  struct SolveJob final : PoolJob {
+    void run(int task, int thread) override;
+    backend::SlidingWindowSolver* solver = nullptr;
+    int iterations = 0;
+    backend::SolveSummary summary;
+    uint64_t allocations = 0;
+  };
+  SolveJob solve_;
+  mutable WorkerPool pool_{1};  // last: its thread stops before the job goes
 };
 
 }  // namespace mcslam

@@ -8,9 +8,11 @@
 
 #include "mcslam/calib/camera_model.hpp"
 
-namespace mcslam::sim {
+namespace mcslam {
+class WorkerPool;
+}
 
-class ThreadPool;
+namespace mcslam::sim {
 
 struct CameraLut {
   struct Tile {
@@ -24,8 +26,9 @@ struct CameraLut {
   };
   int width = 0, height = 0, tile = 16, tiles_x = 0, tiles_y = 0;
   // 4 floats per pixel: bearing x, y, z and angular size (radians; 0 = invalid pixel), stored tile by tile (each
-  // tile's rays row-major in one block, partial tiles padded): the renderer walks the image tile by tile, and a
-  // row-major table made every tile row a separate stream from memory that the prefetcher did not follow.
+  // tile's rays row-major in one block, partial tiles padded): the renderer walks the image tile by tile, and in
+  // a row-major table every row of a tile would be a separate stream from memory, which the prefetcher does not
+  // follow.
   std::vector<float> rays;
   std::vector<Tile> tiles;
 
@@ -36,7 +39,7 @@ struct CameraLut {
   // Sets the sizes and the tile layout (before the rays are filled in).
   void layout(int w, int h, int tile_size);
 
-  static std::shared_ptr<const CameraLut> get(const CameraModel& model, int tile, ThreadPool& pool);
+  static std::shared_ptr<const CameraLut> get(const CameraModel& model, int tile, WorkerPool& pool);
 
  private:
   std::size_t index(int x, int y) const { return 4 * (static_cast<std::size_t>(row_start_[y]) + col_offset_[x]); }

@@ -13,8 +13,9 @@ inline uint64_t mix64(uint64_t x) {  // splitmix64 finaliser
   return x ^ (x >> 31);
 }
 
-// 32-bit finaliser (Wellons' "lowbias32"): for the per-pixel sensor noise, where mix64's two 64-bit products
-// were a visible share of the render time. U: uint32_t, or a vector of them (lanes hashed independently).
+// 32-bit finaliser (Wellons' "lowbias32"): for the per-pixel sensor noise, which hashes every pixel of every
+// frame and is cheaper with 32-bit products than with mix64's two 64-bit ones. U: uint32_t, or a vector of
+// them (lanes hashed independently).
 template <class U>
 inline U hash32(U x) {
   x ^= x >> 16;

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "hash.hpp"
-#include "thread_pool.hpp"
+#include "mcslam/core/worker_pool.hpp"
 #include "world_data.hpp"
 
 namespace mcslam::sim {
@@ -152,7 +152,7 @@ bool buried(const WorldData& w, int prim, int face) {
 
 }  // namespace
 
-void bakeLightmaps(WorldData& w, double cell_size, ThreadPool& pool) {
+void bakeLightmaps(WorldData& w, double cell_size, WorkerPool& pool) {
   // Allocate one grid per lit face.
   w.lightmaps.clear();
   std::size_t total = 0;
@@ -182,7 +182,7 @@ void bakeLightmaps(WorldData& w, double cell_size, ThreadPool& pool) {
     }
   }
   w.lightmap_values.assign(total, 0.f);
-  pool.run(static_cast<int>(jobs.size()), [&](int job) {
+  pool.forEach(static_cast<int>(jobs.size()), [&](int job) {
     const auto [pi, f] = jobs[job];
     const Prim& p = w.prims[pi];
     const LightmapRecord& lm = w.lightmaps[w.faces[p.face0 + f].lightmap];

@@ -46,7 +46,7 @@ void tracePacket(const FrameContext& ctx, const std::vector<Candidate>& cands, c
   const i4 face_y = inv[1] < 0.f ? i4{3, 3, 3, 3} : i4{2, 2, 2, 2};
   const i4 face_z = inv[2] < 0.f ? i4{5, 5, 5, 5} : i4{4, 4, 4, 4};
 
-  // Inlined, so that the packet's state stays in registers (as a called lambda it went through memory).
+  // Inlined, so that the packet's state stays in registers (a called lambda would pass it through memory).
   auto test = [&](int j) __attribute__((always_inline)) {
     const Candidate& c = cands[j];
     if (!c.fast) {

@@ -18,14 +18,14 @@
 #include "frame_context.hpp"
 #include "packet_trace.hpp"
 #include "sensor_model.hpp"
-#include "thread_pool.hpp"
+#include "sim_pool.hpp"
 
 namespace mcslam::sim {
 
 struct Renderer::Impl {
-  Impl(const RenderOptions& o, const detail::WorldData& world) : pool(o.threads), sensor(o.sensor, o.seed), ctx(world) {}
+  Impl(const RenderOptions& o, const detail::WorldData& world) : pool(poolWorkers(o.threads)), sensor(o.sensor, o.seed), ctx(world) {}
 
-  ThreadPool pool;
+  WorkerPool pool;
   SensorModel sensor;
   FrameContext ctx;
   std::vector<std::shared_ptr<const CameraLut>> luts;
@@ -252,12 +252,12 @@ void Renderer::Impl::shadingPass(int tile, float weight, bool accumulate, bool e
 
 namespace {
 
-// Runs fn over the tiles in runs of neighbours: threads taking alternate tiles wrote to the same cache lines (a
-// tile's 16 bytes of an image row, the headers of neighbouring candidate lists) and bounced them between cores.
+// Runs fn over the tiles in runs of neighbours: threads taking alternate tiles would write to the same cache lines
+// (a tile's 16 bytes of an image row, the headers of neighbouring candidate lists) and bounce them between cores.
 template <class Fn>
-void runTiles(ThreadPool& pool, int tiles, const Fn& fn) {
+void runTiles(WorkerPool& pool, int tiles, const Fn& fn) {
   constexpr int kRun = 4;
-  pool.run((tiles + kRun - 1) / kRun, [&](int run) {
+  pool.forEach((tiles + kRun - 1) / kRun, [&](int run) {
     for (int tile = run * kRun; tile < std::min(tiles, (run + 1) * kRun); ++tile) fn(tile);
   });
 }
@@ -323,7 +323,7 @@ void Renderer::render(int cam, const std::function<SE3(double)>& T_w_b_at, doubl
     runTiles(m.pool, tiles, [&m](int tile) { m.visibilityPass(tile); });
     if (depth && s == subs / 2) {
       const bool range = options_.depth == DepthKind::Range;
-      m.pool.run(H, [&](int y) {
+      m.pool.forEach(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
           const std::size_t i = static_cast<std::size_t>(y) * W + x;
           depth->data[i] = m.key[i] ? (range ? m.t[i] : m.t[i] * m.lut->ray(x, y)[2]) : 0.f;

@@ -16,73 +16,102 @@ double wrapAngle(double a) {
   return a;
 }
 
+// Per corner: turn angle, radius and tangent length of its fillet. Throws InputError when two fillets do not
+// fit on the segment between their corners.
+struct Fillets {
+  std::vector<double> turn, tangent, radius;
+};
+
+Fillets cornerFillets(const RouteSpec& spec) {
+  const auto& P = spec.corners;
+  const int n = static_cast<int>(P.size());
+  Fillets f{std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
+  for (int i = 0; i < n; ++i) {
+    const Vec2 a = (P[i] - P[(i + n - 1) % n]).normalized(), b = (P[(i + 1) % n] - P[i]).normalized();
+    f.turn[i] = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+    f.radius[i] = i < static_cast<int>(spec.radii.size()) ? spec.radii[i] : 1.0;
+    f.tangent[i] = f.radius[i] * std::tan(std::abs(f.turn[i]) / 2);
+  }
+  for (int i = 0; i < n; ++i) {  // fillets must fit on their segments
+    const double seg = (P[(i + 1) % n] - P[i]).norm();
+    if (f.tangent[i] + f.tangent[(i + 1) % n] > seg + 1e-9) {
+      throw InputError("route: corner radii too large for the segment from corner " + std::to_string(i) + " to " +
+                       std::to_string((i + 1) % n));
+    }
+  }
+  return f;
+}
+
+struct Piece {
+  double length, curvature;
+};
+
+// Piecewise-constant curvature, starting half-way along the segment from corner 0 to corner 1 (first_half
+// from there to the first fillet); `stops` gets the arc length where each stop corner's arc starts.
+std::vector<Piece> curvaturePieces(const RouteSpec& spec, const Fillets& f, double first_half,
+                                   std::vector<double>& stops) {
+  const auto& P = spec.corners;
+  const int n = static_cast<int>(P.size());
+  std::vector<Piece> pieces;
+  double s = 0;
+  pieces.push_back({first_half, 0.0});
+  s += first_half;
+  for (int k = 1; k <= n; ++k) {
+    const int i = k % n;
+    if (std::find(spec.stops.begin(), spec.stops.end(), i) != spec.stops.end()) stops.push_back(s);
+    const double arc = f.radius[i] * std::abs(f.turn[i]);
+    pieces.push_back({arc, f.turn[i] / arc});
+    s += arc;
+    const double seg = (P[(i + 1) % n] - P[i]).norm() - f.tangent[i] - f.tangent[(i + 1) % n];
+    const double straight = k == n ? first_half : seg;
+    pieces.push_back({straight, 0.0});
+    s += straight;
+  }
+  return pieces;
+}
+
+// The pieces' curvature at the centres of m steps, then smoothed by a periodic box of 2 half + 1 steps (which
+// keeps the total turn, so the heading still closes).
+std::vector<double> smoothCurvature(const std::vector<Piece>& pieces, int m, double step, int half) {
+  std::vector<double> kappa(m, 0.0);
+  {
+    std::size_t pi = 0;
+    double start = 0;
+    for (int j = 0; j < m; ++j) {
+      const double sj = (j + 0.5) * step;
+      while (pi + 1 < pieces.size() && sj > start + pieces[pi].length) start += pieces[pi++].length;
+      kappa[j] = pieces[pi].curvature;
+    }
+  }
+  std::vector<double> curvature(m, 0.0);
+  double acc = 0;
+  for (int j = -half; j <= half; ++j) acc += kappa[(j % m + m) % m];
+  for (int j = 0; j < m; ++j) {
+    curvature[j] = acc / (2 * half + 1);
+    acc += kappa[(j + half + 1) % m] - kappa[((j - half) % m + m) % m];
+  }
+  return curvature;
+}
+
 }  // namespace
 
 RouteCurve::RouteCurve(const RouteSpec& spec, double smoothing, double step) : step_(step) {
   const auto& P = spec.corners;
   const int n = static_cast<int>(P.size());
   if (n < 3) throw InputError("route: needs at least 3 corners, has " + std::to_string(n));
-  // Per corner: turn angle, tangent length of its fillet.
-  std::vector<double> turn(n), tangent(n), radius(n);
-  for (int i = 0; i < n; ++i) {
-    const Vec2 a = (P[i] - P[(i + n - 1) % n]).normalized(), b = (P[(i + 1) % n] - P[i]).normalized();
-    turn[i] = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
-    radius[i] = i < static_cast<int>(spec.radii.size()) ? spec.radii[i] : 1.0;
-    tangent[i] = radius[i] * std::tan(std::abs(turn[i]) / 2);
-  }
-  for (int i = 0; i < n; ++i) {  // fillets must fit on their segments
-    const double seg = (P[(i + 1) % n] - P[i]).norm();
-    if (tangent[i] + tangent[(i + 1) % n] > seg + 1e-9) {
-      throw InputError("route: corner radii too large for the segment from corner " + std::to_string(i) + " to " +
-                       std::to_string((i + 1) % n));
-    }
-  }
-  // Piecewise-constant curvature, starting half-way along the segment from corner 0 to corner 1.
-  struct Piece {
-    double length, curvature;
-  };
-  std::vector<Piece> pieces;
-  std::vector<double> stop_at_piece;
+  const Fillets f = cornerFillets(spec);
+  const double first_half = 0.5 * ((P[1] - P[0]).norm() - f.tangent[0] - f.tangent[1]);
+  const std::vector<Piece> pieces = curvaturePieces(spec, f, first_half, stops_);
   double s = 0;
-  const double first_half = 0.5 * ((P[1] - P[0]).norm() - tangent[0] - tangent[1]);
-  pieces.push_back({first_half, 0.0});
-  s += first_half;
-  for (int k = 1; k <= n; ++k) {
-    const int i = k % n;
-    if (std::find(spec.stops.begin(), spec.stops.end(), i) != spec.stops.end()) stops_.push_back(s);
-    const double arc = radius[i] * std::abs(turn[i]);
-    pieces.push_back({arc, turn[i] / arc});
-    s += arc;
-    const double seg = (P[(i + 1) % n] - P[i]).norm() - tangent[i] - tangent[(i + 1) % n];
-    const double straight = k == n ? first_half : seg;
-    pieces.push_back({straight, 0.0});
-    s += straight;
-  }
+  for (const Piece& piece : pieces) s += piece.length;
   length_ = s;
   const int m = static_cast<int>(std::ceil(length_ / step_));
   step_ = length_ / m;
-  std::vector<double> kappa(m, 0.0);
-  {
-    std::size_t pi = 0;
-    double start = 0;
-    for (int j = 0; j < m; ++j) {
-      const double sj = (j + 0.5) * step_;
-      while (pi + 1 < pieces.size() && sj > start + pieces[pi].length) start += pieces[pi++].length;
-      kappa[j] = pieces[pi].curvature;
-    }
-  }
-  // Periodic box smoothing of the curvature (keeps the total turn, so the heading still closes).
   const int half = std::max(1, static_cast<int>(std::lround(0.5 * smoothing / step_)));
-  curvature_.assign(m, 0.0);
-  double acc = 0;
-  for (int j = -half; j <= half; ++j) acc += kappa[(j % m + m) % m];
-  for (int j = 0; j < m; ++j) {
-    curvature_[j] = acc / (2 * half + 1);
-    acc += kappa[(j + half + 1) % m] - kappa[((j - half) % m + m) % m];
-  }
+  curvature_ = smoothCurvature(pieces, m, step_, half);
   // Integrate heading and position; spread the small position closure error linearly.
   const Vec2 start_dir = (P[1] - P[0]).normalized();
-  const Vec2 start_point = P[0] + (tangent[0] + first_half) * start_dir;
+  const Vec2 start_point = P[0] + (f.tangent[0] + first_half) * start_dir;
   double heading = std::atan2(start_dir.y(), start_dir.x());
   points_.resize(m + 1);
   heading_.resize(m + 1);

@@ -49,7 +49,7 @@ inline int floorInt(float v) {
 }
 inline int clampBelow(int v, int n) { return v < 0 ? 0 : (v >= n ? n - 1 : v); }
 // Vectors are built and taken apart in registers: setting lanes one by one goes through the stack, and reading
-// the 16 bytes back then stalls on store forwarding (which showed in the profile).
+// the 16 bytes back then stalls on store forwarding.
 // {f(0), f(1), f(2), f(3)}
 template <class F>
 inline f4 lanes(F f) {

@@ -11,7 +11,7 @@
 #include "mcslam/dataset/image_file.hpp"
 #include "texture_kinds.hpp"
 #include "texture_paint.hpp"
-#include "thread_pool.hpp"
+#include "mcslam/core/worker_pool.hpp"
 
 namespace mcslam::sim {
 
@@ -107,10 +107,10 @@ PaintCache& paintCache() {
 
 }  // namespace
 
-std::vector<MipTexture> TextureLibrary::generate(ThreadPool& pool) const {
+std::vector<MipTexture> TextureLibrary::generate(WorkerPool& pool) const {
   std::vector<MipTexture> out(requests_.size());
   std::vector<std::string> errors(requests_.size());
-  pool.run(static_cast<int>(requests_.size()), [&](int i) {
+  pool.forEach(static_cast<int>(requests_.size()), [&](int i) {
     try {
       if (photo_of_request_[i] >= 0) {
         out[i] = photoTexture(photos_[photo_of_request_[i]]);

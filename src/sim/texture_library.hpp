@@ -9,9 +9,11 @@
 #include "mcslam/sim/world.hpp"
 #include "mip_texture.hpp"
 
-namespace mcslam::sim {
+namespace mcslam {
+class WorkerPool;
+}
 
-class ThreadPool;
+namespace mcslam::sim {
 
 class TextureLibrary {
  public:
@@ -23,7 +25,7 @@ class TextureLibrary {
   // Texel size to use for a tiled photograph (it spans about 1.5 m).
   double photoTexelSize(int index) const;
   // Generates every requested texture, in request order.
-  std::vector<MipTexture> generate(ThreadPool& pool) const;
+  std::vector<MipTexture> generate(WorkerPool& pool) const;
 
  private:
   uint64_t seed_;

@@ -6,7 +6,7 @@
 #include "lightmap_baker.hpp"
 #include "mcslam/core/error.hpp"
 #include "texture_library.hpp"
-#include "thread_pool.hpp"
+#include "sim_pool.hpp"
 #include "world_data.hpp"
 
 namespace mcslam::sim {
@@ -181,28 +181,33 @@ void WorldBuilder::addWalker(const Walker& walker) {
   data_->walkers.push_back(walker);
 }
 
-std::shared_ptr<const World> WorldBuilder::build() {
-  if (!data_) throw std::logic_error("WorldBuilder::build called twice");
-  WorldData& d = *data_;
-  TextureLibrary library(seed_, textures_dir_);
-  ThreadPool pool(0);
+namespace {
 
-  // Which object owns each face (fitted textures are unique per object), and the face's size.
+// Which object owns each face (fitted textures are unique per object), and the face's index within it.
+struct FaceOwners {
+  std::vector<int> owner;          // prim index, -1 for a walker's face
+  std::vector<int> face_in_owner;
+};
+
+FaceOwners faceOwners(const WorldData& d) {
   const std::size_t n_faces = d.face_materials.size();
-  std::vector<int> owner(n_faces, -1);
-  std::vector<int> face_in_owner(n_faces, 0);
+  FaceOwners fo{std::vector<int>(n_faces, -1), std::vector<int>(n_faces, 0)};
   for (std::size_t i = 0; i < d.prims.size(); ++i) {
     for (int f = 0; f < d.prims[i].faceCount(); ++f) {
-      owner[d.prims[i].face0 + f] = static_cast<int>(i);
-      face_in_owner[d.prims[i].face0 + f] = f;
+      fo.owner[d.prims[i].face0 + f] = static_cast<int>(i);
+      fo.face_in_owner[d.prims[i].face0 + f] = f;
     }
   }
   for (std::size_t w = 0; w < d.walkers.size(); ++w) {
-    for (int f = 0; f < 6; ++f) face_in_owner[d.walker_face0[w] + f] = f;
+    for (int f = 0; f < 6; ++f) fo.face_in_owner[d.walker_face0[w] + f] = f;
   }
+  return fo;
+}
 
+// Every face's record from its material, the textured ones with their texture requested from the library.
+void requestTextures(WorldData& d, const FaceOwners& fo, uint64_t seed, TextureLibrary& library) {
+  const std::size_t n_faces = d.face_materials.size();
   d.faces.assign(n_faces, FaceRecord{});
-  std::vector<int> texture_of_face(n_faces, -1);
   for (std::size_t i = 0; i < n_faces; ++i) {
     const Material& m = d.face_materials[i];
     FaceRecord& fr = d.faces[i];
@@ -213,16 +218,18 @@ std::shared_ptr<const World> WorldBuilder::build() {
     }
     int variant = m.variant;
     if (variant < 0) {
-      variant = isFittedKind(m.kind) ? owner[i] : static_cast<int>(hashOf(seed_, i, 77) % kTilingVariants);
+      variant = isFittedKind(m.kind) ? fo.owner[i] : static_cast<int>(hashOf(seed, i, 77) % kTilingVariants);
     }
-    texture_of_face[i] = library.request(m.kind, variant);
-    fr.texture = texture_of_face[i];
+    fr.texture = library.request(m.kind, variant);
     fr.albedo = static_cast<float>(m.albedo);
   }
-  d.textures = library.generate(pool);
+}
 
-  // Texture coordinates: fitted faces span the texture once, tiled faces repeat it at the material's texel size
-  // from a random offset.
+// Texture coordinates: fitted faces span the texture once, tiled faces repeat it at the material's texel size
+// from a random offset.
+void mapTextures(WorldData& d, const FaceOwners& fo, uint64_t seed, const TextureLibrary& library) {
+  const std::vector<int>& owner = fo.owner;
+  const std::vector<int>& face_in_owner = fo.face_in_owner;
   auto faceExtent = [&](std::size_t i, float& w, float& h) {
     if (owner[i] >= 0) {
       detail::faceSize(d.prims[owner[i]], face_in_owner[i], w, h);
@@ -237,7 +244,7 @@ std::shared_ptr<const World> WorldBuilder::build() {
     }
     w = h = 1.f;
   };
-  for (std::size_t i = 0; i < n_faces; ++i) {
+  for (std::size_t i = 0; i < d.faces.size(); ++i) {
     FaceRecord& fr = d.faces[i];
     if (fr.texture < 0) continue;
     const Material& m = d.face_materials[i];
@@ -259,12 +266,24 @@ std::shared_ptr<const World> WorldBuilder::build() {
         const double periods = std::max(1.0, std::round(static_cast<double>(fw) * fr.su / tex.width()));
         fr.su = static_cast<float>(periods * tex.width() / fw);
       }
-      Rng rng(hashOf(seed_, i, 91));
+      Rng rng(hashOf(seed, i, 91));
       fr.ou = static_cast<float>(rng.uniform(0, tex.width()));
       fr.ov = static_cast<float>(rng.uniform(0, tex.height()));
     }
   }
+}
 
+}  // namespace
+
+std::shared_ptr<const World> WorldBuilder::build() {
+  if (!data_) throw std::logic_error("WorldBuilder::build called twice");
+  WorldData& d = *data_;
+  TextureLibrary library(seed_, textures_dir_);
+  WorkerPool pool(poolWorkers(0));
+  const FaceOwners owners = faceOwners(d);
+  requestTextures(d, owners, seed_, library);
+  d.textures = library.generate(pool);
+  mapTextures(d, owners, seed_, library);
   d.bvh.build(d.prims);
   bakeLightmaps(d, lightmap_cell_, pool);
   precomputeBoxFaces(d);

@@ -61,21 +61,9 @@ void addCar(WorldBuilder& b, Rng& rng, const Vec2& c, double yaw) {
   }
 }
 
-}  // namespace
-
-std::shared_ptr<const World> buildCourtyardWorld(const WorldOptions& options) {
-  WorldBuilder b(options.seed, "courtyard", options.textures_dir);
-  Rng rng(hashOf(options.seed, 0xc0a7));
-
-  RouteSpec route;
-  route.corners = {Vec2(-12, -8.5), Vec2(12, -8.5), Vec2(12, 8.5), Vec2(-12, 8.5)};
-  route.radii = {2.5, 1.5, 2.5, 1.5};
-  route.stops = {2};
-  route.clearance = 0.6;
-  const RouteCurve curve(route);
-
-  // Ground: paving in the square, and round it (coarser light map) out to the far buildings; an asphalt strip
-  // for parking along the south side.
+// Ground: paving in the square, and round it (coarser light map) out to the far buildings; an asphalt strip
+// for parking along the south side.
+void addGround(WorldBuilder& b) {
   const Material paving = Material::texture(TextureKind::Paving, 1.0, 0.0025);
   b.addBox(Vec3(-27, -20, -0.1), Vec3(26, 18, 0.0), paving);
   b.addBox(Vec3(-80, -80, -0.1), Vec3(80, -20, 0.0), paving);
@@ -83,8 +71,10 @@ std::shared_ptr<const World> buildCourtyardWorld(const WorldOptions& options) {
   b.addBox(Vec3(-80, -20, -0.1), Vec3(-27, 18, 0.0), paving);
   b.addBox(Vec3(26, -20, -0.1), Vec3(80, 18, 0.0), paving);
   b.addBox(Vec3(-24, -17.5, 0.0), Vec3(24, -12.5, 0.005), Material::texture(TextureKind::Asphalt, 1.0, 0.003));
+}
 
-  // Buildings round the square, and a taller one seen through the gap in the north-east corner.
+// Buildings round the square, and a taller one seen through the gap in the north-east corner.
+void addBuildings(WorldBuilder& b, Rng& rng) {
   struct Building {
     Vec3 lo, hi;
   };
@@ -96,8 +86,10 @@ std::shared_ptr<const World> buildCourtyardWorld(const WorldOptions& options) {
   for (const Building& bd : buildings) {
     b.addBox(bd.lo, bd.hi, Material::texture(TextureKind::Facade, rng.uniform(0.8, 1.15), 0.012));
   }
+}
 
-  // Planted centre: hedges round a lawn, trees, and benches facing the path.
+// Planted centre: hedges round a lawn, trees, and benches facing the path.
+void addPlantedCentre(WorldBuilder& b, Rng& rng) {
   b.addBox(Vec3(-7, -4, 0), Vec3(7, 4, 0.03), Material::texture(TextureKind::Grass, 1.0, 0.003));
   const Material hedge = Material::texture(TextureKind::Foliage, 1.0, 0.003);
   b.addBox(Vec3(-7, -4.6, 0), Vec3(7, -4.0, 0.9), hedge);
@@ -107,12 +99,11 @@ std::shared_ptr<const World> buildCourtyardWorld(const WorldOptions& options) {
     addBench(b, rng, Vec2(x, -5.6), -M_PI / 2);
     addBench(b, rng, Vec2(x, 5.6), M_PI / 2);
   }
-  // Outer ring: trees, lamps, bins, a kiosk and parked cars, away from the loop.
-  layout::KeepOut keep;
-  keep.route = &curve;
-  keep.route_margin = 1.6;
-  keep.lanes = {{Vec2(-20, 14.5), Vec2(14, 14.5)}, {Vec2(-22, -11.0), Vec2(-22, 11.0)}};
-  keep.lane_margin = 0.8;
+}
+
+// Outer ring: trees, lamps, bins, a kiosk and parked cars, away from the loop and the lanes of `keep` (each
+// piece placed becomes a lane of its own, so that the later ones keep their distance).
+void addOuterRing(WorldBuilder& b, Rng& rng, layout::KeepOut& keep) {
   const Vec2 lo(-26, -19), hi(25, 17.5);
   for (int placed = 0, tries = 0; tries < 400 && placed < 22; ++tries) {
     const Vec2 c(rng.uniform(lo.x() + 1, hi.x() - 1), rng.uniform(lo.y() + 1, hi.y() - 1));
@@ -130,8 +121,32 @@ std::shared_ptr<const World> buildCourtyardWorld(const WorldOptions& options) {
   for (double x = -20.0; x < 20.0; x += rng.uniform(5.5, 8.0)) addCar(b, rng, Vec2(x, -15.0), 0.0);
   b.addBox(Vec3(18, 12, 0), Vec3(21, 15, 2.8), Material::fitted(TextureKind::Poster));  // kiosk
   for (double x : {-16.0, -8.0, 8.0, 16.0}) addLamp(b, Vec2(x, 11.5));
+}
 
-  if (options.moving_objects) {
+}  // namespace
+
+std::shared_ptr<const World> buildCourtyardWorld(const WorldOptions& options) {
+  WorldBuilder b(options.seed, "courtyard", options.textures_dir);
+  Rng rng(hashOf(options.seed, 0xc0a7));
+
+  RouteSpec route;
+  route.corners = {Vec2(-12, -8.5), Vec2(12, -8.5), Vec2(12, 8.5), Vec2(-12, 8.5)};
+  route.radii = {2.5, 1.5, 2.5, 1.5};
+  route.stops = {2};
+  route.clearance = 0.6;
+  const RouteCurve curve(route);
+
+  addGround(b);
+  addBuildings(b, rng);
+  addPlantedCentre(b, rng);
+  layout::KeepOut keep;
+  keep.route = &curve;
+  keep.route_margin = 1.6;
+  keep.lanes = {{Vec2(-20, 14.5), Vec2(14, 14.5)}, {Vec2(-22, -11.0), Vec2(-22, 11.0)}};
+  keep.lane_margin = 0.8;
+  addOuterRing(b, rng, keep);
+
+  if (options.moving_objects) {  // people walking along the two lanes
     const double speeds[] = {1.3, 1.2};
     for (int i = 0; i < 2; ++i) {
       Walker w;

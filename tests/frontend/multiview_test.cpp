@@ -5,6 +5,8 @@
 
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/features/multiview_matcher.hpp"
+#include "mcslam/features/pair_matcher.hpp"
+#include "mcslam/features/track_builder.hpp"
 #include "synthetic_rigs.hpp"
 
 using namespace mcslam;
@@ -195,4 +197,155 @@ TEST(MultiViewMatcher, BearingsAgreeWithTheCameraModel) {
     EXPECT_GT(checked, 1000);
     EXPECT_LT(worst, 1e-7);  // radians: 1e-4 px at these focal lengths
   }
+}
+
+// ---- The matcher's pieces on their own ----
+
+TEST(KeypointBearings, AgreeWithTheCameraModelAnywhereInTheImage) {
+  for (const Rig& rig : {test::isecRig(), test::ring8Rig(100.0)}) {
+    const KeypointBearings bearings(rig);
+    std::mt19937 rng(31);
+    for (int c = 0; c < rig.size(); ++c) {
+      std::uniform_real_distribution<double> x(-2.0, rig.model(c).width() + 1.0), y(-2.0, rig.model(c).height() + 1.0);
+      for (int k = 0; k < 2000; ++k) {
+        const Vec2 uv(x(rng), y(rng));
+        Vec3 expected, b;
+        const bool ok = rig.model(c).unproject(uv, expected);
+        ASSERT_EQ(bearings.bearingOf(rig, c, uv, b), ok) << uv.transpose();
+        if (ok) {
+          EXPECT_LT((b - expected).norm(), 1e-7) << "camera " << c << " at " << uv.transpose();
+        }
+      }
+    }
+  }
+}
+
+namespace {
+
+// The pair matches of a synthetic frame, with the pairs taken in `order` and pair p on thread p % threads.
+std::vector<PairMatch> pairMatches(const Rig& rig, const OverlapMap& overlap, SyntheticFrame& s,
+                                   const std::vector<int>& order, int threads) {
+  const KeypointBearings bearings(rig);
+  PairMatcher pairs(overlap, MultiViewOptions{}, kCapacity, threads);
+  pairs.beginFrame();
+  for (int c = 0; c < rig.size(); ++c) {
+    bearings.compute(rig, s.features, c);
+    pairs.prepareCamera(rig, s.features, c);
+  }
+  for (int p : order) pairs.matchPair(rig, s.features, p, p % threads);
+  const std::span<const PairMatch> m = pairs.gather();
+  return {m.begin(), m.end()};
+}
+
+}  // namespace
+
+TEST(PairMatcher, MutualMatchesOfTrueCornersInsideTheEpipolarGateWhateverThePairOrder) {
+  const Rig rig = test::isecRig();
+  const OverlapMap overlap(rig, OverlapOptions{});
+  std::mt19937 rng(32);
+  SyntheticFrame s = makeFrame(rig, 600, 200, 0.3, rng);
+  std::vector<int> forward(overlap.overlappingPairs().size());
+  for (std::size_t p = 0; p < forward.size(); ++p) forward[p] = static_cast<int>(p);
+  const std::vector<PairMatch> matches = pairMatches(rig, overlap, s, forward, 1);
+  ASSERT_GT(matches.size(), 300u);
+
+  const MultiViewOptions opt;
+  int correct = 0, previous_pair = -1;
+  std::vector<std::vector<int>> used(rig.size(), std::vector<int>(kCapacity, -1));  // pair that matched a keypoint
+  for (const PairMatch& m : matches) {
+    const auto& pairs = overlap.overlappingPairs();
+    const int pair = static_cast<int>(std::find(pairs.begin(), pairs.end(), std::make_pair<int, int>(m.cam_a, m.cam_b)) - pairs.begin());
+    ASSERT_LT(pair, static_cast<int>(pairs.size())) << "a match between cameras that do not overlap";
+    EXPECT_GE(pair, previous_pair) << "matches not in pair order";
+    previous_pair = pair;
+    EXPECT_NE(used[m.cam_a][m.kp_a], pair) << "keypoint matched twice in one pair";
+    EXPECT_NE(used[m.cam_b][m.kp_b], pair) << "keypoint matched twice in one pair";
+    used[m.cam_a][m.kp_a] = used[m.cam_b][m.kp_b] = pair;
+    EXPECT_LE(m.distance, opt.max_hamming);
+    correct += s.truth[m.cam_a][m.kp_a] >= 0 && s.truth[m.cam_a][m.kp_a] == s.truth[m.cam_b][m.kp_b] ? 1 : 0;
+    // Inside the gate: the ray of b is within the gate's angle of the epipolar plane of a.
+    const Vec3 e = (rig.T_b_c(m.cam_b).t - rig.T_b_c(m.cam_a).t).normalized();
+    const Vec3 da = rig.T_b_c(m.cam_a).R * s.features.bearings[m.cam_a][m.kp_a];
+    const Vec3 db = rig.T_b_c(m.cam_b).R * s.features.bearings[m.cam_b][m.kp_b];
+    const Keypoint& kb = s.features.sets[m.cam_b].keypoints[m.kp_b];
+    const double fj = 0.5 * (rig.model(m.cam_b).fx() + rig.model(m.cam_b).fy());
+    EXPECT_LE(std::abs(e.cross(da).normalized().dot(db)), opt.epipolar_px * std::pow(opt.octave_scale, kb.octave) / fj + 1e-6);
+  }
+  EXPECT_GE(correct, 0.99 * static_cast<double>(matches.size())) << correct << " of " << matches.size();
+
+  // The same matches with the pairs matched backwards on two threads' scratch.
+  std::vector<int> backward(forward.rbegin(), forward.rend());
+  const std::vector<PairMatch> again = pairMatches(rig, overlap, s, backward, 2);
+  ASSERT_EQ(again.size(), matches.size());
+  for (std::size_t k = 0; k < matches.size(); ++k) {
+    EXPECT_TRUE(again[k].cam_a == matches[k].cam_a && again[k].cam_b == matches[k].cam_b &&
+                again[k].kp_a == matches[k].kp_a && again[k].kp_b == matches[k].kp_b &&
+                again[k].distance == matches[k].distance) << "match " << k;
+  }
+}
+
+// The true matches of a frame, plus worse false ones that would put two keypoints of one camera into a track:
+// the tracks are the true points (the false matches lose to the better true ones), and the builder allocates
+// nothing once warm.
+TEST(TrackBuilder, JoinsTrueMatchesIntoTracksAndRefusesTwoKeypointsOfOneCamera) {
+  const Rig rig = test::isecRig();
+  const OverlapMap overlap(rig, OverlapOptions{});
+  std::mt19937 rng(33);
+  SyntheticFrame s = makeFrame(rig, 500, 0, 0.2, rng);
+  const KeypointBearings bearings(rig);
+  for (int c = 0; c < rig.size(); ++c) bearings.compute(rig, s.features, c);
+  // Keypoint of point p in camera c (or -1).
+  auto keypointOf = [&](int c, int p) {
+    const auto it = std::find(s.truth[c].begin(), s.truth[c].end(), p);
+    return it == s.truth[c].end() ? -1 : static_cast<int>(it - s.truth[c].begin());
+  };
+  std::vector<PairMatch> matches;
+  int false_matches = 0;
+  for (const auto& [i, j] : overlap.overlappingPairs()) {
+    int previous = -1;  // the last point seen by both: its keypoint in j is the false partner of the next one's in i
+    for (int p = 0; p < static_cast<int>(s.scene.size()); ++p) {
+      const int a = keypointOf(i, p), b = keypointOf(j, p);
+      if (a < 0 || b < 0) continue;
+      matches.push_back(PairMatch{static_cast<int16_t>(i), static_cast<int16_t>(j), a, b, 10});
+      if (previous >= 0 && p % 5 == 0) {
+        matches.push_back(PairMatch{static_cast<int16_t>(i), static_cast<int16_t>(j), a, keypointOf(j, previous), 40});
+        ++false_matches;
+      }
+      previous = p;
+    }
+  }
+  ASSERT_GT(false_matches, 20);
+  TrackBuilder builder(overlap, MultiViewOptions{}, kCapacity);
+  FrameFeatures& f = s.features;
+  for (int round = 0; round < 2; ++round) {
+    alloc::ThreadScope scope;
+    builder.merge(f, matches, false);
+    EXPECT_EQ(builder.alignTaskCount(), 0);
+    f.mv_count = f.mv_ref_count = 0;
+    builder.emitTracks(rig, f);
+    if (round == 1) {
+      EXPECT_EQ(scope.count(), 0u);
+    }
+  }
+  EXPECT_EQ(builder.stats().pair_matches, static_cast<int>(matches.size()));
+  EXPECT_EQ(builder.stats().tracks, f.mv_count);
+  int seen_twice = 0, metric = 0, depth_ok = 0;
+  for (const test::ScenePoint& p : s.scene) seen_twice += std::count(p.visible.begin(), p.visible.end(), true) >= 2;
+  for (int t = 0; t < f.mv_count; ++t) {
+    const MultiViewFeature& mv = f.mv[t];
+    const int p0 = s.truth[f.mv_refs[mv.first].cam][f.mv_refs[mv.first].index];
+    uint64_t cams = 0;
+    for (int k = 0; k < mv.size; ++k) {
+      const KeypointRef& r = f.mv_refs[mv.first + k];
+      EXPECT_FALSE(cams & (uint64_t{1} << r.cam)) << "two keypoints of one camera in track " << t;
+      cams |= uint64_t{1} << r.cam;
+      EXPECT_EQ(s.truth[r.cam][r.index], p0) << "track " << t << " joins two points";
+    }
+    if (!mv.metric) continue;
+    ++metric;
+    depth_ok += (mv.p_b - s.scene[p0].p_b).norm() < 0.02 * s.scene[p0].p_b.norm() ? 1 : 0;
+  }
+  EXPECT_GE(f.mv_count, 0.95 * seen_twice) << f.mv_count << " tracks of " << seen_twice << " points seen twice";
+  EXPECT_GT(metric, f.mv_count / 2);
+  EXPECT_GE(depth_ok, 0.98 * metric) << depth_ok << " of " << metric;
 }

@@ -92,7 +92,7 @@ TEST(FrontEnd, MatchingOnTheWorkersGivesTheSequentialFeatures) {
   }
 }
 
-// The alignment's tasks triangulate and judge the tracks they aligned (MultiViewMatcher::solveTrack) for the
+// The alignment's tasks triangulate and judge the tracks they aligned (TrackBuilder::solveTrack) for the
 // emission: in reverse order they must give compute()'s features and counts (nothing carried from task to task).
 TEST(FrontEnd, AlignmentTasksInReverseOrderGiveTheSameTracks) {
   sim::Simulation& sim = test::sharedSimulation("isec", "indoor");

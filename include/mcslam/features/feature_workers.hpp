@@ -1,8 +1,8 @@
 #pragma once
-// Per-camera ORB extraction on persistent worker threads, one rig frame at a time.
+// Per-camera ORB extraction on persistent worker threads (a WorkerPool), one rig frame at a time.
 //
 // One thread per camera, or a pool of hardware_concurrency() threads when there are more cameras than
-// cores (threads take the next camera from a shared counter). One OrbExtractor per thread, sized for the
+// cores (threads take the next camera in order). One OrbExtractor per thread, sized for the
 // largest camera: an extractor's buffers are scratch, so a camera's output does not depend on which
 // extractor ran it, and five cameras on two threads keep two extractors' buffers, not five.
 // extract() is the per-rig-frame barrier: it returns when every camera is done. The threads start in
@@ -10,12 +10,11 @@
 // only on its image, never on which thread ran it.
 #include <condition_variable>
 #include <cstdint>
-#include <memory>
 #include <mutex>
-#include <thread>
 #include <utility>
 #include <vector>
 
+#include "mcslam/core/worker_pool.hpp"
 #include "mcslam/features/orb_extractor.hpp"
 
 namespace mcslam {
@@ -48,7 +47,6 @@ class FeatureWorkers {
   // max_sizes: the largest image of each camera. threads <= 0: min(cameras, hardware_concurrency()).
   // Throws mcslam::InputError on bad options or no camera.
   FeatureWorkers(const OrbOptions& options, const std::vector<ImageSize>& max_sizes, int threads = 0);
-  ~FeatureWorkers();
   FeatureWorkers(const FeatureWorkers&) = delete;
   FeatureWorkers& operator=(const FeatureWorkers&) = delete;
 
@@ -65,39 +63,46 @@ class FeatureWorkers {
   void setFollowUp(ExtractionFollowUp* follow_up);
 
   int cameras() const { return static_cast<int>(max_sizes_.size()); }
-  int threads() const { return static_cast<int>(threads_.size()); }
+  int threads() const { return pool_.threads(); }
   // The extractor of worker thread `thread` (sized for the largest camera).
   const OrbExtractor& extractor(int thread) const { return extractors_[static_cast<size_t>(thread)]; }
 
  private:
-  void run(int thread);
+  // A rig frame as one batch of the pool: tasks [0, cameras) extract the cameras, the follow-up's tasks come
+  // after them. The pool hands tasks out in index order, so when a follow-up task is taken every camera has a
+  // thread: it takes any follow-up task whose cameras are done, waiting for one if none is yet.
+  struct FrameJob final : PoolJob {
+    explicit FrameJob(FeatureWorkers& w) : workers(w) {}
+    void run(int task, int thread) override { workers.runFrameTask(task, thread); }
+    FeatureWorkers& workers;
+  };
+  struct BatchJob final : PoolJob {  // runTasks()'s
+    void run(int task, int thread) override { tasks->runTask(task, thread); }
+    WorkerTasks* tasks = nullptr;
+  };
+  void runFrameTask(int task, int thread);
   void processCamera(int camera, OrbExtractor& extractor);
   int takeReadyTask();  // -1 when no untaken task has both cameras done (caller holds mutex_)
 
   std::vector<ImageSize> max_sizes_;     // per camera: an image larger than this is refused
   std::vector<OrbExtractor> extractors_;  // per thread
-  std::vector<std::thread> threads_;
 
-  std::mutex mutex_;
-  std::condition_variable work_ready_, work_done_, camera_done_;
-  uint64_t frame_ = 0;     // incremented for each rig frame (guarded by mutex_)
-  int next_camera_ = 0;    // next camera to take (guarded by mutex_)
-  int remaining_ = 0;      // cameras and tasks not finished yet (guarded by mutex_)
-  bool stopping_ = false;  // guarded by mutex_
-
+  std::mutex mutex_;                  // the follow-up's bookkeeping during a frame
+  std::condition_variable camera_done_;
   ExtractionFollowUp* follow_up_ = nullptr;
   int tasks_ = 0;                  // of the follow-up, per frame
-  int untaken_tasks_ = 0;          // guarded by mutex_
   std::vector<uint8_t> done_;      // per camera, this frame (guarded by mutex_)
   std::vector<uint8_t> taken_;     // per task, this frame (guarded by mutex_)
-  WorkerTasks* batch_ = nullptr;   // runTasks()'s (guarded by mutex_)
-  int batch_next_ = 0, batch_count_ = 0;
 
-  // The current frame's arguments, valid while remaining_ > 0.
+  // The current frame's arguments, valid during extract().
   const ImageView* images_ = nullptr;
   const bool* present_ = nullptr;
   FeatureSet* out_ = nullptr;
   OrbStatus* status_ = nullptr;
+
+  FrameJob frame_job_{*this};
+  BatchJob batch_job_;
+  WorkerPool pool_;  // last: its threads stop before the members above go
 };
 
 }  // namespace mcslam

@@ -1,12 +1,12 @@
-// MultiViewMatcher's subpixel alignment of the partners of every track to its reference keypoint (multiview:
-// align_subpixel, on by default). It runs between mergeFrame() and emitTracks(), in tasks of consecutive tracks
+// TrackBuilder's subpixel alignment of the partners of every track to its reference keypoint (multiview:
+// align_subpixel, on by default). It runs between merge() and emitTracks(), in tasks of consecutive tracks
 // that the caller may spread over threads: a track's alignment reads only the frame (keypoints, bearings,
 // images) and writes only its own members, counters and observations, so the result does not depend on which
 // thread aligned which task, nor in which order.
 #include <algorithm>
 #include <cmath>
 
-#include "mcslam/features/multiview_matcher.hpp"
+#include "mcslam/features/track_builder.hpp"
 
 namespace mcslam {
 
@@ -15,29 +15,31 @@ namespace {
 constexpr int kTracksPerAlignTask = 48;
 }  // namespace
 
-int MultiViewMatcher::alignTaskCount() const {
+int TrackBuilder::alignTaskCount() const {
   return aligned_frame_ ? (track_count_ + kTracksPerAlignTask - 1) / kTracksPerAlignTask : 0;
 }
 
-void MultiViewMatcher::alignTracks(const FrameFeatures& f, int task) {
+void TrackBuilder::alignTracks(const Rig& rig, const KeypointBearings& bearings, const ImageView* images,
+                               const FrameFeatures& f, int task) {
   const int begin = task * kTracksPerAlignTask, end = std::min(track_count_, begin + kTracksPerAlignTask);
   for (int t = begin; t < end; ++t) {
-    if (t + 1 < end) prefetchPatches(f, t + 1);  // not beyond the task: another thread may be reordering it
-    alignTrack(f, t);
+    if (t + 1 < end) prefetchPatches(images, f, t + 1);  // not beyond the task: another thread may be reordering it
+    alignTrack(rig, bearings, images, f, t);
     // Solved here too: the triangulation is most of the emission's work, and the workers share it.
-    track_solution_[t] = solveTrack(f, members_.data() + track_first_[t], aligned_obs_.data() + track_first_[t], track_size_[t]);
+    track_solution_[t] =
+        solveTrack(rig, f, members_.data() + track_first_[t], aligned_obs_.data() + track_first_[t], track_size_[t]);
   }
 }
 
-// The alignment reads a patch around every keypoint of a track in images that the workers, on other cores,
-// extracted: its loads miss the cache and dominated its time (each track's first patch reads waited for memory).
-// The next track's patches are requested while this one is aligned.
-void MultiViewMatcher::prefetchPatches(const FrameFeatures& f, int t) const {
+// The alignment reads a patch around every keypoint of a track in images that the workers extracted on other
+// cores, so its loads would miss this core's cache: the next track's patches are requested while this one is
+// aligned.
+void TrackBuilder::prefetchPatches(const ImageView* images, const FrameFeatures& f, int t) const {
   const int32_t* nodes = members_.data() + track_first_[t];
   const int h = std::clamp(options_.alignment.half_size, 1, AlignmentTemplate::kMaxHalf);
   for (int s = 0; s < track_size_[t]; ++s) {
     const int cam = nodes[s] / capacity_;
-    const ImageView& im = images_[cam];
+    const ImageView& im = images[cam];
     if (im.empty()) continue;
     const Keypoint& kp = f.sets[cam].keypoints[nodes[s] % capacity_];
     // The patch, its ring of derivatives and the shift bound, at this keypoint's scale (the warp between the
@@ -56,7 +58,8 @@ void MultiViewMatcher::prefetchPatches(const FrameFeatures& f, int t) const {
 // patches disagree move past the track's new size and stay mono features. An aligned track's rays all pass
 // through the scene point of the reference pixel: that pixel defines the point, so the reference keeps only
 // the alignment's floor sigma.
-void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
+void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, const ImageView* images,
+                              const FrameFeatures& f, int t) {
   int32_t* nodes = members_.data() + track_first_[t];
   Member* obs = aligned_obs_.data() + track_first_[t];
   int size = track_size_[t];
@@ -80,33 +83,11 @@ void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
   ReferencePatch reference;
   Vec2 ref_uv(kr.x, kr.y);
   reference.bearing = obs[0].bearing;
-  if (!makeAlignmentTemplate(images_[ref_cam], ref_uv, sigma_[kr.octave], options_.alignment, reference.patch)) {
-    return;  // every partner would be NotRefinable
-  }
   bool recentred = false;
-  if (options_.recentre_reference) {
-    // The corner's pixel is where FAST found it, up to its ring's radius from the structure that the patch
-    // aligns (at a silhouette: the edge, while the pixel shows the background behind it).
-    const Vec2 moved = ref_uv + informationCentroid(reference.patch);
-    Vec3 bearing;
-    if (bearingOf(ref_cam, moved, bearing)) {
-      if (makeAlignmentTemplate(images_[ref_cam], moved, sigma_[kr.octave], options_.alignment, reference.patch)) {
-        ref_uv = moved;
-        reference.bearing = bearing;
-        recentred = true;
-      } else if (!makeAlignmentTemplate(images_[ref_cam], ref_uv, sigma_[kr.octave], options_.alignment,
-                                        reference.patch)) {  // the failed attempt overwrote it: sampled again
-        return;
-      }
-    }
-  }
-  Vec2 uv_r;
-  Mat23 J_r;
-  if (!rig_.model(ref_cam).project(reference.bearing, uv_r, &J_r)) return;
-  reference.J_pinv = J_r.transpose() * (J_r * J_r.transpose()).inverse();
+  if (!makeReference(rig, bearings, images[ref_cam], ref_cam, kr, reference, ref_uv, recentred)) return;
   bool any = false;
   for (int s = 1; s < size;) {
-    const AlignmentStatus status = alignPartner(f, nodes[0], nodes[s], reference, obs[s]);
+    const AlignmentStatus status = alignPartner(rig, images, f, nodes[0], nodes[s], reference, obs[s]);
     if (status == AlignmentStatus::Disagrees) {
       ++track_disagreeing_[t];
       swap(s, size - 1);
@@ -128,20 +109,49 @@ void MultiViewMatcher::alignTrack(const FrameFeatures& f, int t) {
   track_size_[t] = size;
 }
 
+// The reference patch of keypoint kp of camera `cam` at ref_uv (and ref.bearing), recentred on its information
+// when the options ask (then ref_uv, ref.bearing and `recentred` say where), with the pseudo-inverse of its
+// projection's Jacobian. False when the patch cannot be sampled: every partner would be NotRefinable.
+bool TrackBuilder::makeReference(const Rig& rig, const KeypointBearings& bearings, const ImageView& image, int cam,
+                                 const Keypoint& kp, ReferencePatch& ref, Vec2& ref_uv, bool& recentred) const {
+  if (!makeAlignmentTemplate(image, ref_uv, sigma_[kp.octave], options_.alignment, ref.patch)) return false;
+  if (options_.recentre_reference) {
+    // The corner's pixel is where FAST found it, up to its ring's radius from the structure that the patch
+    // aligns (at a silhouette: the edge, while the pixel shows the background behind it).
+    const Vec2 moved = ref_uv + informationCentroid(ref.patch);
+    Vec3 bearing;
+    if (bearings.bearingOf(rig, cam, moved, bearing)) {
+      if (makeAlignmentTemplate(image, moved, sigma_[kp.octave], options_.alignment, ref.patch)) {
+        ref_uv = moved;
+        ref.bearing = bearing;
+        recentred = true;
+      } else if (!makeAlignmentTemplate(image, ref_uv, sigma_[kp.octave], options_.alignment,
+                                        ref.patch)) {  // the failed attempt overwrote it: sampled again
+        return false;
+      }
+    }
+  }
+  Vec2 uv_r;
+  Mat23 J_r;
+  if (!rig.model(cam).project(ref.bearing, uv_r, &J_r)) return false;
+  ref.J_pinv = J_r.transpose() * (J_r * J_r.transpose()).inverse();
+  return true;
+}
+
 // The partner's keypoint aligned to what the reference keypoint shows: the epipolar curve of the reference
 // pixel in the partner camera is Y(rho) = rho * b + m in that camera's frame (rho: inverse range along the
 // reference ray; rho = 0 is the point at infinity), the start is the partner keypoint projected onto it, and
 // the patch warp is the derivative of the reference pixel -> partner pixel map there. ref: the track's
 // reference patch and the pseudo-inverse of its projection's Jacobian at the unit bearing. Fills `out` when Ok.
-AlignmentStatus MultiViewMatcher::alignPartner(const FrameFeatures& f, int ref_node, int node, const ReferencePatch& ref,
-                                               Member& out) const {
+AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* images, const FrameFeatures& f, int ref_node,
+                                           int node, const ReferencePatch& ref, Member& out) const {
   const int r_cam = ref_node / capacity_;
   const int p_cam = node / capacity_, p_index = node % capacity_;
-  const ImageView& image = images_[p_cam];
+  const ImageView& image = images[p_cam];
   if (image.empty()) return AlignmentStatus::NotRefinable;
-  const SE3& T_b_r = rig_.T_b_c(r_cam);
-  const SE3& T_b_p = rig_.T_b_c(p_cam);
-  const CameraModel& model_p = rig_.model(p_cam);
+  const SE3& T_b_r = rig.T_b_c(r_cam);
+  const SE3& T_b_p = rig.T_b_c(p_cam);
+  const CameraModel& model_p = rig.model(p_cam);
   const Vec3& bearing_r = ref.bearing;
   const Mat3 R_p_b = T_b_p.R.transpose();
   const Vec3 b = R_p_b * (T_b_r.t - T_b_p.t);
