@@ -97,4 +97,13 @@ void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {
   timing_.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+void SlamPipeline::keyframes(std::vector<KeyframePose>& out) const {
+  out.clear();
+  const Map& map = odometry_.map();
+  for (int i = 0; i < map.keyframeCapacity(); ++i) {
+    const Keyframe& kf = map.keyframe(i);
+    if (kf.alive) out.push_back(KeyframePose{kf.id, kf.t, kf.T_w_b});
+  }
+}
+
 }  // namespace mcslam
