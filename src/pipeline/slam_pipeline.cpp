@@ -6,9 +6,9 @@ namespace mcslam {
 
 OdometryOptions effectiveOdometryOptions(const PipelineConfig& config, const OverlapMap& overlap) {
   OdometryOptions o = config.odometry;
-  if (config.refine_extrinsics == "on") {
+  if (config.refine_extrinsics == RefineExtrinsics::On) {
     o.refine_extrinsics = true;
-  } else if (config.refine_extrinsics == "off") {
+  } else if (config.refine_extrinsics == RefineExtrinsics::Off) {
     o.refine_extrinsics = false;
   } else {
     // A camera that overlaps no other could not be calibrated against a shared target: its extrinsic
