@@ -14,7 +14,7 @@ OdometryOptions effectiveOdometryOptions(const PipelineConfig& config, const Ove
     // A camera that overlaps no other could not be calibrated against a shared target: its extrinsic
     // was chained (through an IMU) and deserves refinement. Not when no two cameras overlap: the map's
     // metric scale then comes from the calibrated lever arms alone, and refining them with it lets both
-    // shrink together (measured: the map collapsed and tracking was lost, BENCHMARKS.md section 1).
+    // shrink together until the map collapses (docs/design/stages.md).
     bool isolated = false, any_pair = false;
     for (int i = 0; i < overlap.cameras() && overlap.cameras() > 1; ++i) {
       bool any = false;
