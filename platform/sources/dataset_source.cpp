@@ -78,7 +78,8 @@ void DatasetSource::stop() {
 // Waits until frame i is due. False when stopping.
 bool DatasetSource::waitTurn(std::size_t i, uint64_t loop, int64_t start_mono, uint64_t& trigger_index) {
   if (software_) return waitForNewestTrigger(stop_, triggered_, trigger_bell_, trigger_index, trigger_index);
-  if (cfg_.rate == ReplayRate::Fastest) return links_.pressure->waitForRoom(emitted_.load(std::memory_order_relaxed), stop_);
+  if (cfg_.rate == ReplayRate::Fastest)
+    return links_.pressure->waitForRoom(emitted_.load(std::memory_order_relaxed), stop_);
   const auto& frames = dataset_.frames();
   const int64_t offset = static_cast<int64_t>(loop) * loop_period_ns_ + (frames[i].t - frames.front().t);
   const int64_t due = start_mono + static_cast<int64_t>(static_cast<double>(offset) / cfg_.speed);

@@ -115,7 +115,9 @@ class Console {
                  trackingStateName(pose.state), unit);
   }
   void scaleFound(std::size_t i, double sigma) const {
-    if (!quiet_) std::fprintf(stderr, "%smcslam-run: frame %zu: metric scale found (sigma %.1f%%)\n", show_ ? "\r\033[K" : "", i, 100.0 * sigma);
+    if (quiet_) return;
+    std::fprintf(stderr, "%smcslam-run: frame %zu: metric scale found (sigma %.1f%%)\n", show_ ? "\r\033[K" : "", i,
+                 100.0 * sigma);
   }
   void progress(std::size_t i, double total_ms, const PoseEstimate& pose) {
     ms_avg_ = i == 0 ? total_ms : 0.95 * ms_avg_ + 0.05 * total_ms;

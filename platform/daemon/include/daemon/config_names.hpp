@@ -14,7 +14,8 @@ inline constexpr NamedValue<TriggerMode> kTriggerModeNames[] = {
     {"free_running", TriggerMode::FreeRunning}, {"software", TriggerMode::Software}, {"gpio", TriggerMode::Gpio}};
 inline constexpr NamedValue<ReplayRate> kReplayRateNames[] = {{"recorded", ReplayRate::Recorded},
                                                               {"fastest", ReplayRate::Fastest}};
-inline constexpr NamedValue<AtEnd> kAtEndNames[] = {{"exit", AtEnd::Exit}, {"loop", AtEnd::Loop}, {"idle", AtEnd::Idle}};
+inline constexpr NamedValue<AtEnd> kAtEndNames[] = {
+    {"exit", AtEnd::Exit}, {"loop", AtEnd::Loop}, {"idle", AtEnd::Idle}};
 inline constexpr NamedValue<SimPace> kSimPaceNames[] = {{"fastest", SimPace::Fastest}, {"realtime", SimPace::Realtime}};
 inline constexpr NamedValue<RigAssembler::MatchBy> kMatchByNames[] = {
     {"trigger_count", RigAssembler::MatchBy::TriggerCount}, {"timestamp", RigAssembler::MatchBy::Timestamp}};
