@@ -35,16 +35,16 @@ int64_t realtimeNowNs() {
 }
 }  // namespace
 
-AravisSource::AravisSource(const DaemonConfig& config)
-    : config_(config), software_(config.trigger.mode == "software") {
-  for (std::size_t i = 0; i < config.aravis.cameras.size(); ++i) {
+AravisSource::AravisSource(const AravisSourceConfig& config, const SourceContext& context)
+    : config_(config), context_(context), software_(context.trigger.mode == TriggerMode::Software) {
+  for (std::size_t i = 0; i < config.cameras.size(); ++i) {
     auto cam = std::make_unique<Camera>();
     cam->index = static_cast<int>(i);
-    cam->cfg = config.aravis.cameras[i];
-    cam->key = config.file + ": source.aravis.cameras[" + std::to_string(i) + "]";
+    cam->cfg = config.cameras[i];
+    cam->key = context.file + ": source.aravis.cameras[" + std::to_string(i) + "]";
     cam->layout = pixelLayoutFromName(cam->cfg.pixel_format);
-    cam->width = config.rig.model(static_cast<int>(i)).width();
-    cam->height = config.rig.model(static_cast<int>(i)).height();
+    cam->width = context.rig.model(static_cast<int>(i)).width();
+    cam->height = context.rig.model(static_cast<int>(i)).height();
     try {
       open(*cam);
     } catch (...) {
@@ -102,21 +102,21 @@ void AravisSource::open(Camera& cam) {
     arv_camera_set_gain(cam.camera, cam.cfg.gain_db, &err);
     check(err, key + ".gain_db", "camera '" + cam.cfg.id + "' refuses " + std::to_string(cam.cfg.gain_db));
   }
-  const std::string& mode = config_.trigger.mode;
-  if (mode == "gpio") {
+  const TriggerMode mode = context_.trigger.mode;
+  if (mode == TriggerMode::Gpio) {
     arv_camera_set_trigger(cam.camera, cam.cfg.trigger_line.c_str(), &err);
     check(err, key + ".trigger_line", "camera '" + cam.cfg.id + "' cannot trigger on " + cam.cfg.trigger_line);
-  } else if (mode == "software") {
+  } else if (mode == TriggerMode::Software) {
     arv_camera_set_trigger(cam.camera, "Software", &err);
-    check(err, config_.file + ": trigger.mode", "camera '" + cam.cfg.id + "' has no software trigger");
+    check(err, context_.file + ": trigger.mode", "camera '" + cam.cfg.id + "' has no software trigger");
   } else {
     arv_camera_clear_triggers(cam.camera, &err);
     warnIf(err, key, "free-running");
-    arv_camera_set_frame_rate(cam.camera, config_.trigger.rate_hz, &err);
+    arv_camera_set_frame_rate(cam.camera, context_.trigger.rate_hz, &err);
     warnIf(err, key, "frame rate");
   }
   if (arv_camera_is_gv_device(cam.camera)) {
-    if (config_.aravis.packet_size > 0) arv_camera_gv_set_packet_size(cam.camera, config_.aravis.packet_size, &err);
+    if (config_.packet_size > 0) arv_camera_gv_set_packet_size(cam.camera, config_.packet_size, &err);
     else arv_camera_gv_auto_packet_size(cam.camera, &err);
     warnIf(err, key, "packet size");
   }
@@ -128,7 +128,7 @@ void AravisSource::open(Camera& cam) {
   }
   const guint payload = arv_camera_get_payload(cam.camera, &err);
   check(err, key, "payload size");
-  for (uint32_t i = 0; i < config_.aravis.stream_buffers; ++i)  // allocated once, pushed once
+  for (uint32_t i = 0; i < config_.stream_buffers; ++i)  // allocated once, pushed once
     arv_stream_push_buffer(cam.stream, arv_buffer_new(payload, nullptr));
 }
 
@@ -144,9 +144,10 @@ void AravisSource::close(Camera& cam) {
   cam.camera = nullptr;
 }
 
-void AravisSource::start(CameraRings& rings, const TriggerLog& triggers) {
-  rings_ = &rings;
-  triggers_ = &triggers;
+void AravisSource::start(const SourceLinks& links) {
+  rings_ = links.rings;
+  triggers_ = links.triggers;
+  warm_up_ = links.warm_up;
   stop_ = false;
   for (auto& cam : cameras_) {
     GError* err = nullptr;
@@ -206,10 +207,10 @@ void AravisSource::acquire(Camera& cam) {
   char name[16];
   std::snprintf(name, sizeof(name), "mcslam-cam%d", cam.index);
   nameThisThread(name);
-  if (const auto why = setRealtimePriority(config_.realtime.acquisition_priority); !why.empty())
+  if (const auto why = setRealtimePriority(context_.acquisition_priority); !why.empty())
     spdlog::warn("{} thread: {}", name, why);
-  const int64_t timeout_ns = static_cast<int64_t>(config_.aravis.frame_timeout_ms * kMs);
-  const bool triggered = config_.trigger.mode != "free_running";
+  const int64_t timeout_ns = static_cast<int64_t>(config_.frame_timeout_ms * kMs);
+  const bool triggered = context_.trigger.mode != TriggerMode::FreeRunning;
   int64_t last_reopen = 0;
   uint64_t bad_logged = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
@@ -233,7 +234,7 @@ void AravisSource::acquire(Camera& cam) {
         cam.lost = true;
         counters_.lost_events.fetch_add(1, std::memory_order_relaxed);
         spdlog::error("{}: camera '{}' delivered nothing for {} ms: lost; reopening", cam.key, cam.cfg.id,
-                      config_.aravis.frame_timeout_ms);
+                      config_.frame_timeout_ms);
       }
       continue;
     }
@@ -271,7 +272,7 @@ void AravisSource::acquire(Camera& cam) {
     } else if (counters_.bad_frames.fetch_add(1, std::memory_order_relaxed); bad_logged++ < 20) {
       spdlog::warn("{}: bad frame (buffer status {}, {} bytes)", cam.key, static_cast<int>(status), size);
     }
-    cam.meter.note(warm());
+    cam.meter.note(warm_up_->warm());
   }
 }
 

@@ -11,10 +11,10 @@
 namespace mcslam::platform {
 
 namespace {
-DatasetOptions optionsOf(const DaemonConfig& c) {
+DatasetOptions optionsOf(const DatasetSourceConfig& c, const SourceContext& context) {
   DatasetOptions o;
-  o.calibration_override = c.calibration;
-  o.cameras = c.dataset.cameras;
+  o.calibration_override = context.calibration;
+  o.cameras = c.cameras;
   return o;
 }
 
@@ -24,14 +24,14 @@ void copyImage(const Image& from, Image& to) {
 }
 }  // namespace
 
-DatasetSource::DatasetSource(const DaemonConfig& config, const std::atomic<uint64_t>& processed)
-    : cfg_(config.dataset), software_(config.trigger.mode == "software"),
-      dataset_(Dataset::open(config.dataset.path, optionsOf(config))), processed_(processed) {
-  const std::string key = config.file + ": source.dataset";
+DatasetSource::DatasetSource(const DatasetSourceConfig& config, const SourceContext& context)
+    : cfg_(config), software_(context.trigger.mode == TriggerMode::Software),
+      dataset_(Dataset::open(config.path, optionsOf(config, context))) {
+  const std::string key = context.file + ": source.dataset";
   if (dataset_.size() == 0) throw InputError(key + ".path: '" + cfg_.path + "' has no frames");
-  if (dataset_.rig().size() != config.rig.size())
+  if (dataset_.rig().size() != context.rig.size())
     throw InputError(key + ".path: the dataset has " + std::to_string(dataset_.rig().size()) +
-                     " cameras but the configuration's rig has " + std::to_string(config.rig.size()));
+                     " cameras but the configuration's rig has " + std::to_string(context.rig.size()));
   for (const auto& w : dataset_.warnings()) spdlog::warn("dataset: {}", w);
   const auto& frames = dataset_.frames();
   const int64_t span = frames.back().t - frames.front().t;
@@ -62,9 +62,9 @@ bool DatasetSource::fire(uint64_t) {
   return true;
 }
 
-void DatasetSource::start(CameraRings& rings, const TriggerLog& triggers) {
-  rings_ = &rings;
-  triggers_ = &triggers;
+void DatasetSource::start(const SourceLinks& links) {
+  links_ = links;
+  rings_ = links.rings;
   stop_ = false;
   thread_ = std::thread([this] { run(); });
 }
@@ -78,7 +78,8 @@ void DatasetSource::stop() {
 // Waits until frame i is due. False when stopping.
 bool DatasetSource::waitTurn(std::size_t i, uint64_t loop, int64_t start_mono, uint64_t& trigger_index) {
   if (software_) return waitForNewestTrigger(stop_, triggered_, trigger_bell_, trigger_index, trigger_index);
-  if (cfg_.rate == "fastest") return waitForPipeline(stop_, emitted_, processed_);
+  if (cfg_.rate == ReplayRate::Fastest)
+    return links_.pressure->waitForRoom(emitted_.load(std::memory_order_relaxed), stop_);
   const auto& frames = dataset_.frames();
   const int64_t offset = static_cast<int64_t>(loop) * loop_period_ns_ + (frames[i].t - frames.front().t);
   const int64_t due = start_mono + static_cast<int64_t>(static_cast<double>(offset) / cfg_.speed);
@@ -144,13 +145,13 @@ void DatasetSource::run() {
     for (std::size_t i = 0; i < dataset_.size(); ++i) {
       if (!waitTurn(i, loop, start_mono, trigger_index)) return;
       const uint64_t index = software_ ? trigger_index : frame_number;
-      const int64_t trigger_mono = software_ ? triggers_->lookup(index) : monotonicNowNs();
+      const int64_t trigger_mono = software_ ? links_.triggers->lookup(index) : monotonicNowNs();
       emit(i, loop, index, trigger_mono ? trigger_mono : monotonicNowNs());
       ++frame_number;
       if (software_) ++trigger_index;
-      meter_.note(warm());
+      meter_.note(links_.warm_up->warm());
     }
-    if (cfg_.at_end != "loop") break;
+    if (cfg_.at_end != AtEnd::Loop) break;
   }
   finished_.store(true, std::memory_order_release);
   spdlog::info("dataset: replay finished after {} frames", emitted());

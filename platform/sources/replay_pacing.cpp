@@ -2,8 +2,6 @@
 
 #include <time.h>
 
-#include "mcslam/core/time.hpp"
-
 namespace mcslam::platform {
 
 void sleepUntil(int64_t mono_ns) {
@@ -23,18 +21,6 @@ bool waitForNewestTrigger(const std::atomic<bool>& stop, const std::atomic<uint6
     bell.wait(ticket, 100000000);
   }
   return false;
-}
-
-bool waitForPipeline(const std::atomic<bool>& stop, const std::atomic<uint64_t>& emitted,
-                     const std::atomic<uint64_t>& processed) {
-  const int64_t give_up = monotonicNowNs() + 2000000000;
-  while (!stop.load(std::memory_order_relaxed) &&
-         emitted.load(std::memory_order_relaxed) >= processed.load(std::memory_order_acquire) + 2 &&
-         monotonicNowNs() < give_up) {
-    timespec ts{0, 200000};
-    clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
-  }
-  return !stop.load(std::memory_order_relaxed);
 }
 
 }  // namespace mcslam::platform

@@ -25,14 +25,14 @@ sim::SimulationConfig simulationConfig(const SimSourceConfig& s) {
 }
 }  // namespace
 
-SimSource::SimSource(const DaemonConfig& config, const std::atomic<uint64_t>& processed)
-    : cfg_(config.sim), software_(config.trigger.mode == "software"), processed_(processed) {
+SimSource::SimSource(const SimSourceConfig& config, const SourceContext& context)
+    : cfg_(config), software_(context.trigger.mode == TriggerMode::Software) {
   try {
     sim_ = std::make_unique<sim::Simulation>(simulationConfig(cfg_));
   } catch (const InputError& e) {
-    throw InputError(config.file + ": source.sim: " + e.what());
+    throw InputError(context.file + ": source.sim: " + e.what());
   }
-  for (int c = 0; c < config.rig.size(); ++c) sim_cameras_.push_back(cfg_.cameras.empty() ? c : cfg_.cameras[c]);
+  for (int c = 0; c < context.rig.size(); ++c) sim_cameras_.push_back(cfg_.cameras.empty() ? c : cfg_.cameras[c]);
   frames_ = static_cast<uint64_t>(sim_->frameCount());
   loop_period_ns_ = sim_->frameStamp(sim_->frameCount()) - sim_->frameStamp(0);
   spdlog::info("sim: {} world, {}, {} frames at {} Hz, {} cameras", cfg_.world, sim_->trajectory().description(),
@@ -45,9 +45,9 @@ bool SimSource::fire(uint64_t) {
   return true;
 }
 
-void SimSource::start(CameraRings& rings, const TriggerLog& triggers) {
-  rings_ = &rings;
-  triggers_ = &triggers;
+void SimSource::start(const SourceLinks& links) {
+  links_ = links;
+  rings_ = links.rings;
   stop_ = false;
   thread_ = std::thread([this] { run(); });
 }
@@ -67,9 +67,9 @@ void SimSource::health(char* out, std::size_t size) const {
 bool SimSource::waitTurn(uint64_t next, int64_t start_mono, uint64_t& frame) {
   // The newest trigger; the ones missed while rendering are skipped.
   if (software_) return waitForNewestTrigger(stop_, triggered_, trigger_bell_, next, frame);
-  if (cfg_.pace == "fastest") {
+  if (cfg_.pace == SimPace::Fastest) {
     frame = next;
-    return waitForPipeline(stop_, emitted_, processed_);
+    return links_.pressure->waitForRoom(emitted_.load(std::memory_order_relaxed), stop_);
   }
   const double period_ns = 1e9 / cfg_.rate_hz;
   while (!stop_.load(std::memory_order_relaxed)) {
@@ -106,17 +106,17 @@ void SimSource::emit(uint64_t frame, int64_t trigger_mono) {
 void SimSource::run() {
   nameThisThread("mcslam-sim");
   const int64_t start_mono = monotonicNowNs();
-  const bool bounded = cfg_.at_end != "loop";
+  const bool bounded = cfg_.at_end != AtEnd::Loop;
   uint64_t next = 0;
   while (!stop_.load(std::memory_order_relaxed)) {
     uint64_t frame = 0;
     if (!waitTurn(next, start_mono, frame)) return;
     if (bounded && frame >= frames_) break;
     if (frame > next) skipped_.fetch_add(frame - next, std::memory_order_relaxed);
-    const int64_t trigger_mono = software_ ? triggers_->lookup(frame) : monotonicNowNs();
+    const int64_t trigger_mono = software_ ? links_.triggers->lookup(frame) : monotonicNowNs();
     emit(frame, trigger_mono ? trigger_mono : monotonicNowNs());
     next = frame + 1;
-    meter_.note(warm());
+    meter_.note(links_.warm_up->warm());
     if (bounded && next >= frames_) break;
   }
   finished_.store(true, std::memory_order_release);

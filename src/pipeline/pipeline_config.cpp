@@ -1,6 +1,9 @@
 #include "mcslam/pipeline/pipeline_config.hpp"
 
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "mcslam/core/config_section.hpp"
 #include "mcslam/core/error.hpp"
@@ -8,6 +11,18 @@
 namespace mcslam {
 
 namespace {
+
+constexpr std::pair<const char*, RefineExtrinsics> kRefineExtrinsicsNames[] = {
+    {"auto", RefineExtrinsics::Auto}, {"on", RefineExtrinsics::On}, {"off", RefineExtrinsics::Off}};
+
+void readRefineExtrinsics(ConfigSection& s, RefineExtrinsics& value) {
+  std::string name = refineExtrinsicsName(value);
+  std::vector<std::string> names;
+  for (const auto& [n, v] : kRefineExtrinsicsNames) names.push_back(n);
+  s.read("refine_extrinsics", name, names);  // throws, listing the names, for any other value
+  for (const auto& [n, v] : kRefineExtrinsicsNames)
+    if (name == n) value = v;
+}
 
 void readCapacity(ConfigSection s, PipelineConfig& c) {
   s.read("max_features_per_camera", c.orb.max_features, 50, 20000);
@@ -78,13 +93,19 @@ void readBackend(ConfigSection s, PipelineConfig& c) {
   s.read("enabled", o.backend);
   s.read("iterations", o.backend_iterations, 1, 100);
   s.read("thread", o.backend_thread);
-  s.read("refine_extrinsics", c.refine_extrinsics, {"auto", "on", "off"});
+  readRefineExtrinsics(s, c.refine_extrinsics);
   s.read("extrinsic_sigma_translation", o.extrinsic_sigma_translation, 1e-6, 1.0);
   s.read("extrinsic_sigma_rotation_deg", o.extrinsic_sigma_rotation_deg, 1e-4, 45.0);
   s.finish();
 }
 
 }  // namespace
+
+const char* refineExtrinsicsName(RefineExtrinsics r) {
+  for (const auto& [n, v] : kRefineExtrinsicsNames)
+    if (v == r) return n;
+  return "?";
+}
 
 PipelineConfig parsePipelineConfig(const YAML::Node& slam, const std::string& source, const Rig& rig) {
   PipelineConfig c;
@@ -154,7 +175,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    enabled: " << (o.backend ? "true" : "false") << "\n"
      << "    iterations: " << o.backend_iterations << "\n"
      << "    thread: " << (o.backend_thread ? "true" : "false") << "\n"
-     << "    refine_extrinsics: " << c.refine_extrinsics << "\n"
+     << "    refine_extrinsics: " << refineExtrinsicsName(c.refine_extrinsics) << "\n"
      << "    extrinsic_sigma_translation: " << o.extrinsic_sigma_translation << "\n"
      << "    extrinsic_sigma_rotation_deg: " << o.extrinsic_sigma_rotation_deg << "\n";
   return os.str();

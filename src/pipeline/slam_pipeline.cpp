@@ -6,15 +6,15 @@ namespace mcslam {
 
 OdometryOptions effectiveOdometryOptions(const PipelineConfig& config, const OverlapMap& overlap) {
   OdometryOptions o = config.odometry;
-  if (config.refine_extrinsics == "on") {
+  if (config.refine_extrinsics == RefineExtrinsics::On) {
     o.refine_extrinsics = true;
-  } else if (config.refine_extrinsics == "off") {
+  } else if (config.refine_extrinsics == RefineExtrinsics::Off) {
     o.refine_extrinsics = false;
   } else {
     // A camera that overlaps no other could not be calibrated against a shared target: its extrinsic
     // was chained (through an IMU) and deserves refinement. Not when no two cameras overlap: the map's
     // metric scale then comes from the calibrated lever arms alone, and refining them with it lets both
-    // shrink together (measured: the map collapsed and tracking was lost, BENCHMARKS.md section 1).
+    // shrink together until the map collapses (docs/design/stages.md).
     bool isolated = false, any_pair = false;
     for (int i = 0; i < overlap.cameras() && overlap.cameras() > 1; ++i) {
       bool any = false;
@@ -95,6 +95,15 @@ void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {
   computeFeatures(frame, features_, timing_);
   track(features_, frame.sequence, frame.t, out, timing_);
   timing_.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void SlamPipeline::keyframes(std::vector<KeyframePose>& out) const {
+  out.clear();
+  const Map& map = odometry_.map();
+  for (int i = 0; i < map.keyframeCapacity(); ++i) {
+    const Keyframe& kf = map.keyframe(i);
+    if (kf.alive) out.push_back(KeyframePose{kf.id, kf.t, kf.T_w_b});
+  }
 }
 
 }  // namespace mcslam

@@ -49,6 +49,31 @@ TEST(PipelineConfig, BadValuesNameFileAndKey) {
   EXPECT_NE(errorOf("multiview: {min_depth: 5, max_depth: 2}").find("max_depth"), std::string::npos);
 }
 
+// backend.refine_extrinsics is read into its enum and written back by name; anything else is an error that names
+// the file, the key, the value and the choices.
+TEST(PipelineConfig, RefineExtrinsicsIsAnEnumPastTheReader) {
+  const auto refine = [](const std::string& value) {
+    return parsePipelineConfig(YAML::Load("backend: {refine_extrinsics: " + value + "}"), "x.yaml", isec())
+        .refine_extrinsics;
+  };
+  EXPECT_EQ(parsePipelineConfig(YAML::Node(), "defaults", isec()).refine_extrinsics, RefineExtrinsics::Auto);
+  EXPECT_EQ(refine("auto"), RefineExtrinsics::Auto);
+  EXPECT_EQ(refine("on"), RefineExtrinsics::On);
+  EXPECT_EQ(refine("off"), RefineExtrinsics::Off);
+  for (const RefineExtrinsics r : {RefineExtrinsics::Auto, RefineExtrinsics::On, RefineExtrinsics::Off}) {
+    PipelineConfig c;
+    c.refine_extrinsics = r;
+    EXPECT_NE(formatPipelineConfig(c).find(std::string("refine_extrinsics: ") + refineExtrinsicsName(r) + "\n"),
+              std::string::npos);
+    EXPECT_EQ(refine(refineExtrinsicsName(r)), r);
+  }
+  const std::string e = errorOf("backend: {refine_extrinsics: maybe}");
+  EXPECT_NE(e.find("run.yaml"), std::string::npos) << e;
+  EXPECT_NE(e.find("slam.backend.refine_extrinsics"), std::string::npos) << e;
+  EXPECT_NE(e.find("maybe"), std::string::npos) << e;
+  EXPECT_NE(e.find("auto, on, off"), std::string::npos) << e;
+}
+
 // config/slam.yaml documents the defaults: it must stay equal to them.
 TEST(PipelineConfig, ShippedSlamYamlHoldsTheDefaults) {
   const YAML::Node file = YAML::LoadFile(MCSLAM_SOURCE_DIR "/config/slam.yaml");

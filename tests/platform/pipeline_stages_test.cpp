@@ -1,12 +1,15 @@
-// The daemon runs the SLAM pipeline in two stages on two threads (FrameProcessor::prepare, then finish):
-// the front-end of frame i+1 is prepared before frame i is finished. The poses must be those of process().
+// mcslamd and mcslam-run run the SLAM pipeline in two stages (FrameProcessor::prepare, then finish) with
+// StageRunner, on two threads (the front-end of frame i+1 is prepared before frame i is finished) or on one.
+// The poses must be those of process() either way.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <thread>
 #include <vector>
 
 #include "mcslam/dataset/dataset.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
+#include "mcslam/pipeline/stage_runner.hpp"
 #include "sim_dataset_fixture.hpp"
 
 using namespace mcslam;
@@ -59,7 +62,52 @@ void expectStagesGiveTheSamePosesAsProcess(const YAML::Node& slam, const Rig& ri
   EXPECT_GT(tracked, static_cast<int>(n) - 3);  // the comparison is between real estimates
 }
 
+// StageRunner with the prepare side on a thread of its own (overlap) or on the caller's (without).
+std::vector<PoseEstimate> runWithStageRunner(FrameProcessor& processor, const Dataset& dataset,
+                                             std::vector<LoadedFrame>& frames, bool overlap) {
+  StageRunner<std::size_t> runner(processor);
+  const std::size_t n = frames.size();
+  std::vector<PoseEstimate> poses(n);
+  std::thread front_end;
+  if (overlap) {
+    front_end = std::thread([&] {
+      for (std::size_t i = 0; i < n; ++i) runner.prepare(frames[i].view(dataset, i), i);
+      runner.close();
+    });
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!overlap) runner.prepare(frames[i].view(dataset, i), i);
+    std::size_t tag = n;
+    EXPECT_TRUE(runner.finish(poses[i], tag));
+    EXPECT_EQ(tag, i);
+  }
+  if (front_end.joinable()) front_end.join();
+  return poses;
+}
+
 }  // namespace
+
+TEST(PipelineStages, TheStageRunnerGivesTheSamePosesWithAndWithoutOverlapAsProcess) {
+  const Dataset dataset = Dataset::open(test::cachedSimDataset());
+  const std::size_t n = dataset.size();
+  std::vector<LoadedFrame> frames(n);
+  for (std::size_t i = 0; i < n; ++i) dataset.loadImages(i, frames[i].images, frames[i].present, nullptr);
+  const YAML::Node defaults(YAML::NodeType::Map);
+  auto whole = createPipeline(defaults, "test", dataset.rig());
+  auto overlapped = createPipeline(defaults, "test", dataset.rig());
+  auto one_thread = createPipeline(defaults, "test", dataset.rig());
+  std::vector<PoseEstimate> expected(n);
+  for (std::size_t i = 0; i < n; ++i) whole->process(frames[i].view(dataset, i), expected[i]);
+  const std::vector<PoseEstimate> with = runWithStageRunner(*overlapped, dataset, frames, true);
+  const std::vector<PoseEstimate> without = runWithStageRunner(*one_thread, dataset, frames, false);
+  int tracked = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    EXPECT_TRUE(samePose(expected[i], with[i])) << "overlapped, frame " << i;
+    EXPECT_TRUE(samePose(expected[i], without[i])) << "one thread, frame " << i;
+    tracked += with[i].state == TrackingState::Tracking ? 1 : 0;
+  }
+  EXPECT_GT(tracked, static_cast<int>(n) - 3);  // the comparison is between real estimates
+}
 
 TEST(PipelineStages, PreparingTheNextFrameBeforeFinishingThisOneGivesTheSamePosesAsProcess) {
   const YAML::Node defaults(YAML::NodeType::Map);

@@ -17,6 +17,7 @@ bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
   r.timing = timing;
   const bool changed = frames_.empty() || frames_.back().pose.state != pose.state;
   if (changed) changes_.push_back(StateChange{frames_.size(), pose.t, pose.state});
+  if (pose.valid && pose.state == TrackingState::Tracking) last_tracked_unscaled_ = !pose.metric;
   frames_.push_back(r);
   return changed;
 }
@@ -37,11 +38,8 @@ void RunReport::backfill(uint64_t reference_index, uint64_t init_index) {
   }
 }
 
-void RunReport::noteKeyframes(const Map& map) {
-  for (int i = 0; i < map.keyframeCapacity(); ++i) {
-    const Keyframe& kf = map.keyframe(i);
-    if (kf.alive) keyframes_[kf.id] = StampedPose{kf.t, kf.T_w_b};
-  }
+void RunReport::noteKeyframes(const std::vector<KeyframePose>& keyframes) {
+  for (const KeyframePose& kf : keyframes) keyframes_[kf.id] = StampedPose{kf.t, kf.T_w_b};
 }
 
 Trajectory RunReport::trajectory() const {
@@ -136,7 +134,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("keyframes").value(s.keyframes);
   j.key("recoveries").value(s.recoveries);
   j.key("extrinsic_reestimations").value(s.extrinsic_reestimations);
-  j.key("rejected_images").value(pipeline.frontEnd().rejectedImages());
+  j.key("rejected_images").value(pipeline.rejectedImages());
   j.key("timing_ms").beginObject();
   const std::pair<const char*, Summary> stages[] = {{"feature_extraction", summarize(features)},
                                                     {"tracking_and_mapping", summarize(tracking)},

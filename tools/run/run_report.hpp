@@ -31,8 +31,10 @@ class RunReport {
   // After a two-frame initialization at frame `init_index` from reference frame `reference_index`, the
   // frames in between get poses interpolated between the two (they had none of their own).
   void backfill(uint64_t reference_index, uint64_t init_index);
-  // Keyframes currently in the map (their latest optimized poses).
-  void noteKeyframes(const Map& map);
+  // The keyframes in the map now, with their latest optimized poses (a keyframe that left the map keeps its last).
+  void noteKeyframes(const std::vector<KeyframePose>& keyframes);
+  // The last frame that was tracked had no metric scale (one camera; a rig without overlap before its scale).
+  bool lastTrackedUnscaled() const { return last_tracked_unscaled_; }
 
   Trajectory trajectory() const;  // every frame with a pose
   Trajectory keyframes() const;
@@ -46,6 +48,7 @@ class RunReport {
   std::vector<FrameRecord> frames_;
   std::map<int64_t, StampedPose> keyframes_;
   std::vector<StateChange> changes_;
+  bool last_tracked_unscaled_ = false;
 };
 
 }  // namespace mcslam::run

@@ -97,11 +97,7 @@ void writePreview(sim::Simulation& simulation, const std::vector<int>& cameras, 
   sim::writeContactSheet(path, tiles, scale);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"mcslam-sim: render a multi-camera sequence with exact ground truth (ASL dataset + depth)"};
-  app.footer(footer());
+struct SimOptions {
   sim::SimulationConfig cfg;
   std::string out = "mcslam_sim_out", cameras, preview;
   double preview_scale = 0.5;
@@ -109,6 +105,10 @@ int main(int argc, char** argv) {
   bool no_depth = false, no_noise = false, no_exposure = false, no_vignetting = false, no_aa = false;
   bool overwrite = false, quiet = false;
   double blur_ms = 0.0;
+};
+
+void addOptions(CLI::App& app, SimOptions& o) {
+  sim::SimulationConfig& cfg = o.cfg;
   app.add_option("--rig", cfg.rig, "Preset name (isec, stereo, mono, ring8) or Kalibr camchain file")
       ->capture_default_str();
   app.add_option("--world", cfg.world, "indoor, corridor or courtyard")->capture_default_str();
@@ -117,25 +117,98 @@ int main(int argc, char** argv) {
   app.add_option("--rate", cfg.rate_hz, "Frame rate in Hz (the motion is in physical time)")->capture_default_str();
   app.add_option("--seed", cfg.seed, "Seed of the world's layout and textures, the motion's wobble and the sensor noise")
       ->capture_default_str();
-  app.add_option("--out", out, "Output folder")->capture_default_str();
-  app.add_option("--cameras", cameras, "Cameras to write, by index, e.g. 0,2,4 (default: all); the first is the body");
+  app.add_option("--out", o.out, "Output folder")->capture_default_str();
+  app.add_option("--cameras", o.cameras, "Cameras to write, by index, e.g. 0,2,4 (default: all); the first is the body");
   app.add_flag("--moving-objects", cfg.moving_objects, "People-sized boxes walking through the scene");
   app.add_option("--textures", cfg.textures_dir, "Folder of photographs (PNG/JPG) to use instead of procedural textures");
-  app.add_flag("--no-depth", no_depth, "Do not write depth images");
-  app.add_flag("--no-noise", no_noise, "No sensor noise");
-  app.add_flag("--no-exposure-variation", no_exposure, "Same gain for every camera and frame");
-  app.add_flag("--no-vignetting", no_vignetting, "No lens vignetting");
-  app.add_flag("--no-antialiasing", no_aa, "One ray per pixel (aliased edges; faster)");
-  app.add_option("--motion-blur", blur_ms, "Exposure time in ms for motion blur (0 = none)")->capture_default_str();
+  app.add_flag("--no-depth", o.no_depth, "Do not write depth images");
+  app.add_flag("--no-noise", o.no_noise, "No sensor noise");
+  app.add_flag("--no-exposure-variation", o.no_exposure, "Same gain for every camera and frame");
+  app.add_flag("--no-vignetting", o.no_vignetting, "No lens vignetting");
+  app.add_flag("--no-antialiasing", o.no_aa, "One ray per pixel (aliased edges; faster)");
+  app.add_option("--motion-blur", o.blur_ms, "Exposure time in ms for motion blur (0 = none)")->capture_default_str();
   app.add_option("--threads", cfg.render.threads, "Render threads (0 = all cores); does not change the output")
       ->capture_default_str();
-  app.add_flag("--overwrite", overwrite, "Replace the output of a previous run in --out");
-  app.add_flag("--quiet", quiet, "No progress output");
-  app.add_option("--preview", preview,
+  app.add_flag("--overwrite", o.overwrite, "Replace the output of a previous run in --out");
+  app.add_flag("--quiet", o.quiet, "No progress output");
+  app.add_option("--preview", o.preview,
                  "Write a contact sheet (PNG) of one frame of the selected cameras; without --out, only that");
-  app.add_option("--preview-frame", preview_frame, "Frame shown by --preview")->capture_default_str();
-  app.add_option("--preview-scale", preview_scale, "Size of each camera in the contact sheet, relative to its resolution")
+  app.add_option("--preview-frame", o.preview_frame, "Frame shown by --preview")->capture_default_str();
+  app.add_option("--preview-scale", o.preview_scale, "Size of each camera in the contact sheet, relative to its resolution")
       ->capture_default_str();
+}
+
+// The options into the simulation's settings and the export's. Throws InputError naming the option.
+sim::ExportOptions applyOptions(SimOptions& o) {
+  sim::SimulationConfig& cfg = o.cfg;
+  cfg.render.sensor.noise = !o.no_noise;
+  cfg.render.sensor.exposure_variation = !o.no_exposure;
+  cfg.render.sensor.vignetting = !o.no_vignetting;
+  cfg.render.anti_aliasing = !o.no_aa;
+  if (o.blur_ms < 0) throw InputError("--motion-blur must not be negative, got " + std::to_string(o.blur_ms));
+  cfg.render.sensor.motion_blur_s = o.blur_ms * 1e-3;
+  if (cfg.render.threads < 0) throw InputError("--threads must not be negative");
+  sim::ExportOptions options;
+  if (!o.cameras.empty()) {
+    try {
+      options.cameras = parseCameraList(o.cameras);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--cameras: ") + e.what());
+    }
+  }
+  options.depth = !o.no_depth;
+  return options;
+}
+
+// Renders the whole sequence into o.out.
+void writeDataset(sim::Simulation& simulation, const SimOptions& o, sim::ExportOptions options, int cameras,
+                  Timestamp t0) {
+  const sim::SimulationConfig& cfg = o.cfg;
+  if (!o.quiet) {
+    std::fprintf(stderr, "mcslam-sim: %s world, %s, %d frames at %.3g Hz, %d cameras -> %s\n", cfg.world.c_str(),
+                 simulation.trajectory().description().c_str(), simulation.frameCount(), cfg.rate_hz, cameras,
+                 o.out.c_str());
+  }
+  const bool tty = isatty(fileno(stderr));
+  options.description = "mcslam-sim --rig " + cfg.rig + " --world " + cfg.world + " --trajectory " + cfg.trajectory;
+  if (!o.quiet) {
+    options.progress = [tty](int done, int total) {
+      if (tty) std::fprintf(stderr, "\r  frame %d/%d", done, total);
+      else if (done % 100 == 0 || done == total) std::fprintf(stderr, "  frame %d/%d\n", done, total);
+      if (tty && done == total) std::fprintf(stderr, "\n");
+    };
+  }
+  const sim::ExportSummary s = sim::exportDataset(simulation, o.out, options);
+  if (!o.quiet) {
+    std::fprintf(stderr, "mcslam-sim: wrote %d frames x %d cameras (%.1f m in %.1f s of motion) in %.1f s\n", s.frames,
+                 s.cameras, s.path_length, s.duration, toSeconds(monotonicNowNs() - t0));
+  }
+}
+
+void run(SimOptions& o, bool write_dataset) {
+  const sim::ExportOptions options = applyOptions(o);
+  validateEarly(o.cfg, options.cameras, o.preview, o.preview_scale, o.preview_frame);
+  if (write_dataset) prepareOutput(o.out, o.overwrite);
+  const Timestamp t0 = monotonicNowNs();
+  sim::Simulation simulation(o.cfg);
+  std::vector<int> selected = options.cameras;
+  if (selected.empty()) {
+    for (int c = 0; c < simulation.rig().size(); ++c) selected.push_back(c);
+  }
+  if (!o.preview.empty()) {
+    writePreview(simulation, selected, o.preview_frame, o.preview_scale, o.preview);
+    if (!o.quiet) std::fprintf(stderr, "mcslam-sim: wrote %s (frame %d)\n", o.preview.c_str(), o.preview_frame);
+  }
+  if (write_dataset) writeDataset(simulation, o, options, static_cast<int>(selected.size()), t0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mcslam-sim: render a multi-camera sequence with exact ground truth (ASL dataset + depth)"};
+  app.footer(footer());
+  SimOptions options;
+  addOptions(app, options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -144,59 +217,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "mcslam-sim: %s (see --help)\n", e.what());
     return 2;
   }
-
   try {
-    cfg.render.sensor.noise = !no_noise;
-    cfg.render.sensor.exposure_variation = !no_exposure;
-    cfg.render.sensor.vignetting = !no_vignetting;
-    cfg.render.anti_aliasing = !no_aa;
-    if (blur_ms < 0) throw InputError("--motion-blur must not be negative, got " + std::to_string(blur_ms));
-    cfg.render.sensor.motion_blur_s = blur_ms * 1e-3;
-    if (cfg.render.threads < 0) throw InputError("--threads must not be negative");
-    sim::ExportOptions options;
-    if (!cameras.empty()) {
-      try {
-        options.cameras = parseCameraList(cameras);
-      } catch (const InputError& e) {
-        throw InputError(std::string("--cameras: ") + e.what());
-      }
-    }
-    options.depth = !no_depth;
-    validateEarly(cfg, options.cameras, preview, preview_scale, preview_frame);
-    const bool write_dataset = preview.empty() || app.count("--out") > 0;
-    if (write_dataset) prepareOutput(out, overwrite);
-
-    const Timestamp t0 = monotonicNowNs();
-    sim::Simulation simulation(cfg);
-    std::vector<int> selected = options.cameras;
-    if (selected.empty()) {
-      for (int c = 0; c < simulation.rig().size(); ++c) selected.push_back(c);
-    }
-    if (!preview.empty()) {
-      writePreview(simulation, selected, preview_frame, preview_scale, preview);
-      if (!quiet) std::fprintf(stderr, "mcslam-sim: wrote %s (frame %d)\n", preview.c_str(), preview_frame);
-    }
-    if (!write_dataset) return 0;
-    const int cams = static_cast<int>(selected.size());
-    if (!quiet) {
-      std::fprintf(stderr, "mcslam-sim: %s world, %s, %d frames at %.3g Hz, %d cameras -> %s\n", cfg.world.c_str(),
-                   simulation.trajectory().description().c_str(), simulation.frameCount(), cfg.rate_hz, cams,
-                   out.c_str());
-    }
-    const bool tty = isatty(fileno(stderr));
-    options.description = "mcslam-sim --rig " + cfg.rig + " --world " + cfg.world + " --trajectory " + cfg.trajectory;
-    if (!quiet) {
-      options.progress = [tty](int done, int total) {
-        if (tty) std::fprintf(stderr, "\r  frame %d/%d", done, total);
-        else if (done % 100 == 0 || done == total) std::fprintf(stderr, "  frame %d/%d\n", done, total);
-        if (tty && done == total) std::fprintf(stderr, "\n");
-      };
-    }
-    const sim::ExportSummary s = sim::exportDataset(simulation, out, options);
-    if (!quiet) {
-      std::fprintf(stderr, "mcslam-sim: wrote %d frames x %d cameras (%.1f m in %.1f s of motion) in %.1f s\n", s.frames,
-                   s.cameras, s.path_length, s.duration, toSeconds(monotonicNowNs() - t0));
-    }
+    run(options, options.preview.empty() || app.count("--out") > 0);
   } catch (const InputError& e) {
     std::fprintf(stderr, "mcslam-sim: %s\n", e.what());
     return 2;

@@ -14,13 +14,22 @@
 
 namespace mcslam {
 
+// backend.refine_extrinsics: whether the back-end refines the extrinsics online.
+enum class RefineExtrinsics {
+  Auto,  // on when some camera overlaps no other (its calibration was chained), but not when no two cameras overlap
+  On,
+  Off,
+};
+// The name the configuration file gives it (auto, on, off).
+const char* refineExtrinsicsName(RefineExtrinsics r);
+
 struct PipelineConfig {
   OrbOptions orb;
   int feature_threads = 0;              // 0: one per core, at most one per camera
   OverlapOptions overlap;
   MultiViewOptions multiview;
   OdometryOptions odometry;
-  std::string refine_extrinsics = "auto";  // auto: on when some camera overlaps no other (chained calibration)
+  RefineExtrinsics refine_extrinsics = RefineExtrinsics::Auto;
 };
 
 // Defaults for `rig`, overridden by `slam` (may be null). Throws InputError naming `source` and the key.

@@ -16,33 +16,36 @@ struct PipelineTiming {
   double total_ms = 0;
 };
 
+// A keyframe of the map with its latest optimized pose.
+struct KeyframePose {
+  int64_t id = -1;
+  Timestamp t = 0;
+  SE3 T_w_b;
+};
+
 class SlamPipeline final : public FrameProcessor {
  public:
   SlamPipeline(const Rig& rig, const PipelineConfig& config);
 
   void process(const RigFrameView& frame, PoseEstimate& out) override;
-  // The front-end in prepare(), the odometry in finish() (FrameProcessor's stages).
+  // The front-end in prepare(), the odometry in finish() (FrameProcessor's stages; StageRunner runs them).
   int stageSlots() const override { return static_cast<int>(stages_.size()); }
   void prepare(const RigFrameView& frame, int slot) override;
   void finish(int slot, PoseEstimate& out) override;
-
-  // The two stages of process(), for a caller that overlaps the front-end of the next frame with the odometry
-  // of this one (mcslam-run): computeFeatures() may run on another thread, into another FrameFeatures, while
-  // track() runs. Each fills its part of `timing` (features_ms; tracking_ms and optimization_ms).
-  void computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing);
-  void track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out, PipelineTiming& timing);
-  // Completes the back-end work of the last keyframe (track() does it before the next frame): call it after
-  // the last frame, before reading the final map.
+  // Completes the back-end work of the last keyframe (finish() does it before the next frame): call it after
+  // the last frame, before reading the final keyframes.
   void flush() { odometry_.flush(); }
-  // A FrameFeatures sized for this pipeline (allocates).
-  FrameFeatures makeFrameFeatures() const { return FrameFeatures(rig_.size(), config_.orb.max_features); }
 
-  const PipelineTiming& timing() const { return timing_; }
+  // Read on the thread that finishes the frames, between frames.
+  const PipelineTiming& timing() const { return timing_; }  // of the last finished frame
   const OdometryStats& stats() const { return odometry_.stats(); }
-  const FrameFeatures& lastFeatures() const { return features_; }
-  const FrontEnd& frontEnd() const { return front_end_; }
-  const Odometry& odometry() const { return odometry_; }
-  Odometry& odometry() { return odometry_; }
+  uint64_t rejectedImages() const { return front_end_.rejectedImages(); }
+  int cameras() const { return rig_.size(); }
+  bool initialized() const { return odometry_.initialized(); }
+  // The frame the map was last initialized from (its sequence number), -1 before the first initialization.
+  int64_t initializationReference() const { return odometry_.lastInitializationReference(); }
+  // The keyframes in the map now (appended to `out`, which is cleared first).
+  void keyframes(std::vector<KeyframePose>& out) const;
   Rig refinedRig() const { return odometry_.refinedRig(); }
   // The back-end's current extrinsics (the calibration's when refinement is off).
   bool refinedRig(Rig& out) const override {
@@ -52,6 +55,11 @@ class SlamPipeline final : public FrameProcessor {
   const PipelineConfig& config() const { return config_; }
 
  private:
+  // The two halves of process(): the front-end (computeFeatures) and the odometry (track). Each fills its part
+  // of `timing` (features_ms; tracking_ms and optimization_ms).
+  void computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing);
+  void track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out, PipelineTiming& timing);
+
   Rig rig_;
   PipelineConfig config_;
   FrontEnd front_end_;

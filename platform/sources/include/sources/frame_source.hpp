@@ -1,11 +1,13 @@
 #pragma once
-// Where images come from: GenICam cameras (aravis/), a recorded dataset (dataset_source), later the
-// simulator. A source opens its devices in its constructor (throwing InputError naming the config key
+// Where images come from: GenICam cameras (aravis/), a recorded dataset (dataset_source), the simulator
+// (sim_source). A source opens its devices in its constructor (throwing InputError naming the config key
 // when one is unreachable), starts its own threads in start() and writes into the camera rings.
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
 
+#include "realtime/warm_up.hpp"
+#include "sources/back_pressure.hpp"
 #include "sources/camera_rings.hpp"
 #include "trigger/trigger_output.hpp"
 
@@ -17,10 +19,19 @@ struct SourceCounters {
   std::atomic<uint64_t> lost_events{0};  // a camera stopped delivering (and was reopened)
 };
 
+// What a source is connected to while it runs; all of it outlives the source's threads.
+struct SourceLinks {
+  CameraRings* rings = nullptr;            // where the images go, one ring per camera
+  const TriggerLog* triggers = nullptr;    // when each trigger fired (for the trigger-to-pose latency)
+  const BackPressure* pressure = nullptr;  // a lossless replay waits on it
+  const WarmUp* warm_up = nullptr;         // the source's allocation meters count once it is over
+};
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
-  virtual void start(CameraRings& rings, const TriggerLog& triggers) = 0;
+  // Starts the source's threads, which write into links.rings until stop().
+  virtual void start(const SourceLinks& links) = 0;
   virtual void stop() = 0;
   // The software trigger (trigger.mode software), or nullptr when this source has none.
   virtual TriggerOutput* softwareTrigger() { return nullptr; }
@@ -31,15 +42,9 @@ class FrameSource {
   // Heap allocations of the source's own threads since the warm-up ended.
   virtual uint64_t allocationsSinceWarmup() const = 0;
   const SourceCounters& counters() const { return counters_; }
-  // Called by the daemon when the warm-up is over.
-  void endWarmup() { warm_.store(true, std::memory_order_relaxed); }
 
  protected:
-  bool warm() const { return warm_.load(std::memory_order_relaxed); }
   SourceCounters counters_;
-
- private:
-  std::atomic<bool> warm_{false};
 };
 
 }  // namespace mcslam::platform

@@ -1,22 +1,16 @@
 #pragma once
-// The slots that travel through the daemon's rings. All image buffers are sized at start-up; moving a
-// frame from one stage to the next swaps buffers instead of copying or allocating.
+// The slots that travel through the daemon's rings after the assembly (camera images before it:
+// sources/camera_frame.hpp), and the typed rings that carry them. All image buffers are sized at start-up;
+// moving a frame from one stage to the next swaps buffers instead of copying or allocating.
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "mcslam/core/image.hpp"
 #include "mcslam/pipeline/frame_processor.hpp"
+#include "realtime/signalled_ring.hpp"
 
 namespace mcslam::platform {
-
-// One image from one camera (acquisition -> assembly).
-struct CameraFrame {
-  Image image;
-  Timestamp capture_ns = 0;      // time base of the trajectory (dataset stamps, or host CLOCK_REALTIME)
-  uint64_t trigger_index = 0;    // which trigger (or frame number) produced it
-  int64_t trigger_mono_ns = 0;   // CLOCK_MONOTONIC of the trigger (or of the arrival when free-running)
-};
 
 // A synchronized capture of the whole rig (assembly -> processing).
 struct RigFrame {
@@ -46,5 +40,8 @@ struct PoseSlot {
   int64_t trigger_mono_ns = 0;
   int cameras_present = 0;
 };
+
+using RigRing = SignalledRing<RigFrame>;   // assembly -> processing
+using PoseRing = SignalledRing<PoseSlot>;  // processing -> publishing
 
 }  // namespace mcslam::platform

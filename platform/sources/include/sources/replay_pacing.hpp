@@ -1,5 +1,6 @@
 #pragma once
-// Waits shared by the sources that replay frames from a thread of their own (dataset, sim).
+// Waits shared by the sources that replay frames from a thread of their own (dataset, sim). The lossless
+// modes wait on the pipeline's BackPressure.
 #include <atomic>
 #include <cstdint>
 
@@ -14,11 +15,5 @@ void sleepUntil(int64_t mono_ns);
 // a replay skips the triggers it could not keep up with). False when stopping.
 bool waitForNewestTrigger(const std::atomic<bool>& stop, const std::atomic<uint64_t>& triggered, Doorbell& bell,
                           uint64_t served, uint64_t& newest);
-
-// Lossless replay: waits while two emitted frames are not yet processed (one processed, one waiting). Should a
-// frame vanish on the way (e.g. assembled together with another), goes on after 2 s rather than wait forever.
-// False when stopping.
-bool waitForPipeline(const std::atomic<bool>& stop, const std::atomic<uint64_t>& emitted,
-                     const std::atomic<uint64_t>& processed);
 
 }  // namespace mcslam::platform

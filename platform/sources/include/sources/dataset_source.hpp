@@ -9,22 +9,21 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/daemon_config.hpp"
 #include "mcslam/dataset/dataset.hpp"
 #include "realtime/alloc_meter.hpp"
 #include "realtime/doorbell.hpp"
 #include "sources/frame_source.hpp"
+#include "sources/source_config.hpp"
 
 namespace mcslam::platform {
 
 class DatasetSource final : public FrameSource, private TriggerOutput {
  public:
-  // Opens the dataset (and preloads it). `processed` is the daemon's processed-frame count, used to
-  // pace the lossless "fastest" mode. Throws InputError.
-  DatasetSource(const DaemonConfig& config, const std::atomic<uint64_t>& processed);
+  // Opens the dataset (and preloads it). Throws InputError naming source.dataset.
+  DatasetSource(const DatasetSourceConfig& config, const SourceContext& context);
   ~DatasetSource() override { stop(); }
 
-  void start(CameraRings& rings, const TriggerLog& triggers) override;
+  void start(const SourceLinks& links) override;
   void stop() override;
   TriggerOutput* softwareTrigger() override { return software_ ? this : nullptr; }
   bool finished() const override { return finished_.load(std::memory_order_acquire); }
@@ -41,14 +40,13 @@ class DatasetSource final : public FrameSource, private TriggerOutput {
   DatasetSourceConfig cfg_;
   bool software_;
   Dataset dataset_;
-  const std::atomic<uint64_t>& processed_;
   int64_t loop_period_ns_ = 0;  // added to capture times on each loop
   // Preloaded images [frame][camera], or the decode scratch (one frame).
   std::vector<std::vector<Image>> images_;
   std::vector<std::vector<bool>> present_;
   std::string load_error_;
-  CameraRings* rings_ = nullptr;
-  const TriggerLog* triggers_ = nullptr;
+  SourceLinks links_;
+  CameraRings* rings_ = nullptr;  // links_.rings
   std::atomic<uint64_t> triggered_{0};  // software triggers received
   Doorbell trigger_bell_;
   std::atomic<bool> stop_{false};

@@ -2,11 +2,26 @@
 // Strict reading of YAML configuration fields: every error names the file, the full key and the value.
 #include <yaml-cpp/yaml.h>
 
+#include <cstddef>
 #include <initializer_list>
 #include <string>
 #include <vector>
 
 namespace mcslam::platform {
+
+// An enumerated setting's value and the name the configuration file gives it.
+template <typename E>
+struct NamedValue {
+  const char* name;
+  E value;
+};
+
+template <typename E, std::size_t N>
+const char* nameOf(E value, const NamedValue<E> (&names)[N]) {
+  for (const NamedValue<E>& n : names)
+    if (n.value == value) return n.name;
+  return "?";
+}
 
 class YamlFields {
  public:
@@ -26,6 +41,17 @@ class YamlFields {
   uint32_t capacity(const char* key, uint32_t fallback, uint32_t max = 1u << 20) const;
   bool boolean(const char* key, bool fallback) const;
   std::string choice(const char* key, const std::string& fallback, std::initializer_list<const char*> options) const;
+  // One of the names in `options`, as its value (the error lists the names).
+  template <typename E, std::size_t N>
+  E choice(const char* key, E fallback, const NamedValue<E> (&options)[N]) const {
+    const std::string v = string(key, nameOf(fallback, options));
+    std::string list;
+    for (const NamedValue<E>& o : options) {
+      if (v == o.name) return o.value;
+      list += (list.empty() ? "" : ", ") + std::string(o.name);
+    }
+    fail(key, "'" + v + "' is not one of: " + list);
+  }
   std::vector<std::string> stringList(const char* key) const;
   // File permissions: an octal string ("0640") or an integer written in octal (0640 parses as 640).
   unsigned permissions(const char* key, unsigned fallback) const;

@@ -1,6 +1,5 @@
 #pragma once
 // Creates the source named by source.type. Throws InputError (unreachable camera, missing dataset).
-#include <atomic>
 #include <memory>
 
 #include "daemon/daemon_config.hpp"
@@ -8,6 +7,6 @@
 
 namespace mcslam::platform {
 
-std::unique_ptr<FrameSource> createSource(const DaemonConfig& config, const std::atomic<uint64_t>& processed);
+std::unique_ptr<FrameSource> createSource(const DaemonConfig& config);
 
 }  // namespace mcslam::platform

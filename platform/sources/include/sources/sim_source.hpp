@@ -15,21 +15,21 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/daemon_config.hpp"
 #include "mcslam/sim/simulation.hpp"
 #include "realtime/alloc_meter.hpp"
 #include "realtime/doorbell.hpp"
 #include "sources/frame_source.hpp"
+#include "sources/source_config.hpp"
 
 namespace mcslam::platform {
 
 class SimSource final : public FrameSource, private TriggerOutput {
  public:
   // Builds the world, trajectory and renderer. Throws InputError naming source.sim.
-  SimSource(const DaemonConfig& config, const std::atomic<uint64_t>& processed);
+  SimSource(const SimSourceConfig& config, const SourceContext& context);
   ~SimSource() override { stop(); }
 
-  void start(CameraRings& rings, const TriggerLog& triggers) override;
+  void start(const SourceLinks& links) override;
   void stop() override;
   TriggerOutput* softwareTrigger() override { return software_ ? this : nullptr; }
   bool finished() const override { return finished_.load(std::memory_order_acquire); }
@@ -52,9 +52,8 @@ class SimSource final : public FrameSource, private TriggerOutput {
   std::vector<int> sim_cameras_;  // daemon camera -> simulation camera
   uint64_t frames_ = 0;           // frames per pass
   int64_t loop_period_ns_ = 0;    // added to the capture stamps on each pass
-  const std::atomic<uint64_t>& processed_;
-  CameraRings* rings_ = nullptr;
-  const TriggerLog* triggers_ = nullptr;
+  SourceLinks links_;
+  CameraRings* rings_ = nullptr;  // links_.rings
   std::atomic<uint64_t> triggered_{0};
   Doorbell trigger_bell_;
   std::atomic<bool> stop_{false};

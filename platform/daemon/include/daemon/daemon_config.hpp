@@ -7,63 +7,18 @@
 #include <string>
 #include <vector>
 
+#include "aravis/aravis_config.hpp"
+#include "daemon/rig_assembler.hpp"
 #include "mcslam/calib/rig.hpp"
+#include "sources/source_config.hpp"
+#include "trigger/trigger_config.hpp"
 
 namespace mcslam::platform {
 
-struct DatasetSourceConfig {
-  std::string path;
-  std::string rate = "recorded";  // recorded (its time stamps, scaled by speed) | fastest
-  double speed = 1.0;
-  std::string at_end = "exit";    // exit | loop | idle
-  bool preload = false;           // decode every image at start (replay then allocates nothing)
-  uint32_t max_preload_frames = 2000;
-  std::vector<int> cameras;       // calibration indices to use (empty = all)
-};
-
-// Live rendering with the simulator (mcslam_sim): frames are rendered as they are due.
-struct SimSourceConfig {
-  std::string rig = "isec";           // preset (isec, stereo, mono, ring8) or Kalibr camchain file
-  std::string world = "indoor";       // indoor | corridor | courtyard
-  std::string trajectory = "ground";  // ground | handheld | file:PATH (TUM)
-  double rate_hz = 10;                // simulated frame rate: the motion and the capture stamps
-  int frames = 0;                     // 0: as many as the trajectory lasts
-  uint64_t seed = 1;
-  std::string pace = "fastest";       // fastest (lossless, as the pipeline takes frames) | realtime
-  std::string at_end = "loop";        // exit | loop | idle
-  bool anti_aliasing = true;          // false: one ray per pixel, cheaper
-  int render_threads = 0;             // 0: one per core
-  std::vector<int> cameras;           // rig indices to render (empty = all)
-};
-
-struct AravisCameraConfig {
-  std::string id;              // serial number, device ID or IP address
-  double exposure_us = 0;      // 0 = leave as configured on the camera
-  double gain_db = -1;         // < 0 = leave
-  std::string pixel_format = "Mono8";  // Mono8 | BayerRG8 | BayerGR8 | BayerGB8 | BayerBG8
-  std::string trigger_line = "Line1";  // camera input wired to the GPIO pulse (trigger.mode gpio)
-};
-
-struct AravisSourceConfig {
-  std::vector<AravisCameraConfig> cameras;  // in calibration order
-  uint32_t stream_buffers = 8;
-  int packet_size = 0;           // GigE packet size, 0 = negotiate
-  double frame_timeout_ms = 1000;  // no frame for this long: the camera counts as lost and is reopened
-};
-
-struct TriggerConfig {
-  std::string mode = "free_running";  // free_running | software | gpio
-  double rate_hz = 20;
-  std::string gpio_chip;  // gpiochipN, /dev/gpiochipN, label or number
-  int gpio_line = -1;
-  int pulse_us = 100;
-  bool active_low = false;
-};
-
 struct AssemblyConfig {
-  std::string match_by = "trigger_count";  // trigger_count | timestamp
-  double tolerance_ms = 5;                 // timestamp matching
-  double timeout_ms = 200;                 // a rig frame still incomplete after this goes out partial
+  RigAssembler::MatchBy match_by = RigAssembler::MatchBy::TriggerCount;
+  double tolerance_ms = 5;   // timestamp matching
+  double timeout_ms = 200;   // a rig frame still incomplete after this goes out partial
 };
 
 struct CapacityConfig {
@@ -100,7 +55,7 @@ struct DaemonConfig {
   std::string log_level = "info";
   double status_interval_s = 1.0;
   double warmup_frames = 50;  // allocations are counted after this many processed frames
-  std::string source_type;   // dataset | aravis | sim
+  SourceType source_type = SourceType::Dataset;
   std::string calibration;   // Kalibr camchain; optional for a dataset (it has its own)
   DatasetSourceConfig dataset;
   SimSourceConfig sim;
@@ -117,6 +72,8 @@ struct DaemonConfig {
 
 // A finite source that stops the daemon when it has delivered its last frame (at_end: exit).
 bool exitsAtEnd(const DaemonConfig& config);
+// What the configured source takes from the rest of the configuration.
+SourceContext sourceContext(const DaemonConfig& config);
 
 // Parses and validates everything that needs no device (the rig is loaded; the dataset is opened
 // only to read its rig and count). Throws InputError.

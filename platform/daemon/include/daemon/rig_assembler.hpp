@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "daemon/frames.hpp"
+#include "sources/camera_frame.hpp"
 
 namespace mcslam::platform {
 

@@ -9,10 +9,11 @@
 #include <thread>
 #include <vector>
 
+#include "aravis/aravis_config.hpp"
 #include "aravis/pixel_convert.hpp"
-#include "daemon/daemon_config.hpp"
 #include "realtime/alloc_meter.hpp"
 #include "sources/frame_source.hpp"
+#include "sources/source_config.hpp"
 
 typedef struct _ArvCamera ArvCamera;
 typedef struct _ArvStream ArvStream;
@@ -23,10 +24,10 @@ class AravisSource final : public FrameSource, private TriggerOutput {
  public:
   // Opens and configures every camera. Throws InputError naming source.aravis.cameras[i] when a
   // camera is unreachable or refuses a setting.
-  explicit AravisSource(const DaemonConfig& config);
+  AravisSource(const AravisSourceConfig& config, const SourceContext& context);
   ~AravisSource() override;
 
-  void start(CameraRings& rings, const TriggerLog& triggers) override;
+  void start(const SourceLinks& links) override;
   void stop() override;
   TriggerOutput* softwareTrigger() override { return software_ ? this : nullptr; }
   void health(char* out, std::size_t size) const override;
@@ -55,11 +56,13 @@ class AravisSource final : public FrameSource, private TriggerOutput {
   void acquire(Camera& cam);
   bool tryReopen(Camera& cam);
 
-  DaemonConfig config_;
+  AravisSourceConfig config_;
+  SourceContext context_;
   bool software_;
   std::vector<std::unique_ptr<Camera>> cameras_;
   CameraRings* rings_ = nullptr;
   const TriggerLog* triggers_ = nullptr;
+  const WarmUp* warm_up_ = nullptr;
   std::atomic<bool> stop_{false};
 };
 

@@ -4,9 +4,9 @@
 #include <memory>
 #include <vector>
 
-#include "daemon/frames.hpp"
 #include "realtime/doorbell.hpp"
 #include "realtime/drop_oldest_ring.hpp"
+#include "sources/camera_frame.hpp"
 
 namespace mcslam::platform {
 

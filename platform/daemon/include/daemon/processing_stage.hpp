@@ -1,0 +1,67 @@
+#pragma once
+// The daemon's processing: rig frames from the rig ring through the FrameProcessor (the SLAM pipeline), poses
+// into the pose ring. It runs the processor with the pipeline's StageRunner: a processor with stages on two
+// threads, the front-end of the next rig frame (features thread) while the current one is tracked (processing
+// thread); one without on the processing thread alone. Reports each processed frame to the back-pressure of a
+// lossless replay, and ends the warm-up after so many frames.
+#include <atomic>
+#include <thread>
+#include <vector>
+
+#include "daemon/frames.hpp"
+#include "mcslam/pipeline/stage_runner.hpp"
+#include "realtime/alloc_meter.hpp"
+#include "realtime/warm_up.hpp"
+#include "sources/back_pressure.hpp"
+
+namespace mcslam::platform {
+
+class ProcessingStage {
+ public:
+  ProcessingStage(FrameProcessor& processor, int cameras, int priority, uint64_t warmup_frames, RigRing& in,
+                  PoseRing& out, BackPressure& pressure, WarmUp& warm_up);
+  void start();
+  // Asks the threads to end once the rig ring is empty and every prepared frame is finished.
+  void requestStop();
+  bool finished() const { return done_.load(std::memory_order_acquire); }
+  // After requestStop(): join() when finished(), else detach() (a thread stuck inside the processor is left behind).
+  void join();
+  void detach();
+
+  uint64_t processed() const { return processed_.load(std::memory_order_relaxed); }
+  uint64_t poseDrops() const { return pose_drops_.load(std::memory_order_relaxed); }
+  uint64_t waiting() const { return runner_.waiting(); }  // prepared, not yet finished
+  TrackingState tracking() const { return static_cast<TrackingState>(tracking_.load(std::memory_order_relaxed)); }
+  bool unscaled() const { return unscaled_.load(std::memory_order_relaxed); }
+  uint64_t allocationsSinceWarmup() const { return features_meter_.since() + processing_meter_.since(); }
+
+ private:
+  // What the daemon needs to know again about a frame once it is processed.
+  struct FrameTag {
+    int64_t trigger_mono_ns = 0;
+    int cameras_present = 0;
+  };
+  void setUpThread(const char* name, const char* role);
+  void featuresLoop();  // prepare(), on its own thread
+  void trackingLoop();  // finish(), on the processing thread
+  void wholeLoop();     // both in turn on the processing thread, for a processor without stages
+  RigFrameView viewOf(const RigFrame& f);
+  void handOver(PoseSlot& out, const FrameTag& tag);
+
+  StageRunner<FrameTag> runner_;
+  int priority_;
+  uint64_t warmup_frames_;
+  RigRing& in_;
+  PoseRing& out_;
+  BackPressure& pressure_;
+  WarmUp& warm_up_;
+  std::vector<ImageView> views_;  // onto the images of the rig frame being prepared
+  std::thread features_thread_, processing_thread_;
+  std::atomic<bool> stop_{false}, done_{false};
+  std::atomic<uint64_t> processed_{0}, pose_drops_{0};
+  std::atomic<uint8_t> tracking_{0};
+  std::atomic<bool> unscaled_{false};
+  ThreadAllocMeter features_meter_, processing_meter_;
+};
+
+}  // namespace mcslam::platform
