@@ -38,7 +38,7 @@ backend::SolverOptions solverOptions(const OdometryOptions& o, bool monocular) {
 }  // namespace
 
 LocalMapper::LocalMapper(const Rig& rig, const OdometryOptions& options, Map& map, int max_features_per_camera)
-    : rig_(rig),
+    : rig_state_(rig),
       calibration_(rig),
       options_(options),
       map_(map),
@@ -77,10 +77,10 @@ void LocalMapper::reset() {
     // A fresh window (the old one's keyframes and landmarks are gone with the map), on the same prior, starting
     // from the current extrinsics. This allocates: it happens only when tracking was lost, never per frame.
     solver_.reset();
-    solver_ = std::make_unique<backend::SlidingWindowSolver>(calibration_, windowCapacity(options_, map_, rig_.size(), capacity_),
+    solver_ = std::make_unique<backend::SlidingWindowSolver>(calibration_, windowCapacity(options_, map_, rig_state_.cameras(), capacity_),
                                                              solverOptions(options_, monocular_));
-    for (int c = 0; c < rig_.size(); ++c) {  // refused where not refined
-      solver_->setExtrinsic(c, rig_.T_b_c(c), !calibration_dropped_[c]);
+    for (int c = 0; c < rig_state_.cameras(); ++c) {  // refused where not refined
+      solver_->setExtrinsic(c, rig_state_.T_b_c(c), !calibration_dropped_[c]);
     }
   }
   std::fill(touched_flag_.begin(), touched_flag_.end(), 0);
@@ -114,15 +114,19 @@ void LocalMapper::holdScale(bool hold) {
 
 Rig LocalMapper::refinedRig() const {
   if (worker_) worker_->wait();
-  return solver_ ? solver_->refinedRig() : rig_;
+  return solver_ ? solver_->refinedRig() : rig_state_.rig();
 }
 
-const SE3& LocalMapper::extrinsic(int cam) const { return solver_ ? solver_->extrinsic(cam) : rig_.T_b_c(cam); }
+void LocalMapper::adoptSolvedExtrinsics() {
+  if (!solver_) return;
+  for (int c = 0; c < rig_state_.cameras(); ++c) rig_state_.setExtrinsic(c, solver_->extrinsic(c));
+}
 
-bool LocalMapper::setExtrinsic(int cam, const SE3& T_b_c) {
-  if (!solver_ || solving_ || solver_->setExtrinsic(cam, T_b_c) != backend::Status::Ok) return false;
+void LocalMapper::reestimateExtrinsic(int cam, const SE3& T_b_c) {
+  rig_state_.setExtrinsic(cam, T_b_c);
+  rig_state_.markReestimated(cam);
+  if (!solver_ || solving_ || solver_->setExtrinsic(cam, T_b_c) != backend::Status::Ok) return;
   calibration_dropped_[cam] = 1;
-  return true;
 }
 
 int LocalMapper::keyframeSlotOfId(int64_t id) const {
@@ -142,7 +146,7 @@ void LocalMapper::finishTouched() {
   for (int i = 0; i < touched_count_; ++i) {
     const int lm = touched_[i];
     touched_flag_[lm] = 0;
-    if (map_.landmark(lm).alive) map_.updateLandmarkAppearance(lm, rig_, options_.scale_factor, options_.levels);
+    if (map_.landmark(lm).alive) map_.updateLandmarkAppearance(lm, rig_state_.rig(), options_.scale_factor, options_.levels);
   }
   touched_count_ = 0;
 }
@@ -234,8 +238,8 @@ void LocalMapper::linkMultiViewPartners(int slot, const FrameFeatures& frame) {
       if (kf.landmark_of[ref.cam][ref.index] >= 0) continue;
       const Keypoint& kp = frame.sets[ref.cam].keypoints[ref.index];
       Vec2 uv;
-      const Vec3 p_c = (kf.T_w_b * rig_.T_b_c(ref.cam)).inverse() * l.p_w;
-      if (!rig_.model(ref.cam).project(p_c, uv)) continue;
+      const Vec3 p_c = (kf.T_w_b * rig_state_.rig().T_b_c(ref.cam)).inverse() * l.p_w;
+      if (!rig_state_.rig().model(ref.cam).project(p_c, uv)) continue;
       const double e = (uv - Vec2(kp.x, kp.y)).norm() / octave_scale_[kp.octave];
       if (e * e < 5.991 && map_.addObservation(lm, slot, ref.cam, ref.index)) touch(lm);
     }
@@ -266,7 +270,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
     previous[np++] = best;
   }
 
-  const int cams = rig_.size();
+  const int cams = rig_state_.rig().size();
   const double min_depth = std::max(0.05, options_.new_points.min_depth);
   constexpr int kMaxHamming = 50;    // stricter than tracking: nothing else vouches for these matches
   constexpr float kRatio = 0.75f;
@@ -300,12 +304,12 @@ int LocalMapper::triangulateWithPrevious(int slot) {
 
     for (int c2 = 0; c2 < cams; ++c2) {
       if (!kn.features.present[c2]) continue;
-      const SE3 T_w_c2 = kn.T_w_b * rig_.T_b_c(c2);
+      const SE3 T_w_c2 = kn.T_w_b * rig_state_.rig().T_b_c(c2);
       const FeatureSet& set2 = kn.features.sets[c2];
       std::fill(best_.begin(), best_.begin() + set2.count, Best{});
       for (int c1 = 0; c1 < cams; ++c1) {
         if (!ko.features.present[c1]) continue;
-        const SE3 T_w_c1 = ko.T_w_b * rig_.T_b_c(c1);
+        const SE3 T_w_c1 = ko.T_w_b * rig_state_.rig().T_b_c(c1);
         const double axes = std::acos(std::clamp(T_w_c1.R.col(2).dot(T_w_c2.R.col(2)), -1.0, 1.0));
         if (axes > half_fov_[c1] + half_fov_[c2]) continue;  // the two views cannot share a point
         const Vec3 baseline = T_w_c2.t - T_w_c1.t;
@@ -316,7 +320,7 @@ int LocalMapper::triangulateWithPrevious(int slot) {
           band_index_.add(b, T_w_c1.R * ko.features.bearings[c1][b], set1.keypoints[b].octave);
         }
         band_index_.finish();
-        const CameraModel& m1 = rig_.model(c1);
+        const CameraModel& m1 = rig_state_.rig().model(c1);
         const double f1 = 0.5 * (m1.fx() + m1.fy());
         for (int o = 0; o < options_.levels; ++o) gate_[o] = kEpipolarPx * octave_scale_[o] / f1;
 
@@ -378,8 +382,8 @@ int LocalMapper::triangulateWithPrevious(int slot) {
           if (n >= static_cast<int>(tri_obs_.size()) || k.landmark_of[c][idx] >= 0) return;
           TriangulationObservation& o = tri_obs_[n];
           const Keypoint& key = k.features.sets[c].keypoints[idx];
-          o.model = &rig_.model(c);
-          o.T_f_c = k.T_w_b * rig_.T_b_c(c);
+          o.model = &rig_state_.rig().model(c);
+          o.T_f_c = k.T_w_b * rig_state_.rig().T_b_c(c);
           o.uv = Vec2(key.x, key.y);
           o.bearing = k.features.bearings[c][idx];
           o.sigma_px = octave_scale_[key.octave];
@@ -414,7 +418,7 @@ double LocalMapper::sceneInverseDepth(int slot) {
   const Keyframe& k = map_.keyframe(slot);
   int n = 0;
   for (int c = 0; c < k.features.cameras(); ++c) {
-    const Vec3 centre = k.T_w_b * rig_.T_b_c(c).t;
+    const Vec3 centre = k.T_w_b * rig_state_.rig().T_b_c(c).t;
     for (int i = 0; i < k.features.sets[c].count; ++i) {
       const int lm = k.landmark_of[c][i];
       if (lm < 0) continue;

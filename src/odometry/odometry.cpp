@@ -39,25 +39,24 @@ PoseRefinementOptions refinementOptions(const OdometryOptions& o) {
 }  // namespace
 
 Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
-    : rig_(rig),
+    : tracking_rig_(rig),
       options_(options),
       capacity_(max_features_per_camera),
-      map_(rig_, max_features_per_camera, options.max_keyframes, options.max_landmarks),
-      search_(rig_, max_features_per_camera),
-      ransac_(rig_, rig.size() * max_features_per_camera, ransacOptions(options)),
-      refiner_(rig_, rig.size() * max_features_per_camera, refinementOptions(options)) {
-  const int cams = rig_.size();
+      map_(rig, max_features_per_camera, options.max_keyframes, options.max_landmarks),
+      search_(rig, max_features_per_camera),
+      ransac_(rig, rig.size() * max_features_per_camera, ransacOptions(options)),
+      refiner_(rig, rig.size() * max_features_per_camera, refinementOptions(options)) {
+  const int cams = rig.size();
   matches_.allocate(cams, max_features_per_camera, options.max_landmarks);
-  initializer_ = std::make_unique<Initializer>(rig_, options_, max_features_per_camera);
-  mapper_ = std::make_unique<LocalMapper>(rig_, options_, map_, max_features_per_camera);
+  initializer_ = std::make_unique<Initializer>(rig, options_, max_features_per_camera);
+  mapper_ = std::make_unique<LocalMapper>(rig, options_, map_, max_features_per_camera);
   if (options.backend && options.refine_extrinsics && cams > 1) {
-    extrinsic_check_ = std::make_unique<ExtrinsicCheck>(rig_, options_, max_features_per_camera);
+    extrinsic_check_ = std::make_unique<ExtrinsicCheck>(rig, options_, max_features_per_camera);
   }
-  reestimated_.assign(cams, 0);
   if (cams > 1) {
     const int scale_keyframes = std::min(map_.keyframeCapacity(), ScaleEstimator::kMaxKeyframes);
     const int window_obs = scale_keyframes * cams * max_features_per_camera;
-    scale_estimator_ = std::make_unique<ScaleEstimator>(rig_, std::min(options.max_landmarks, window_obs), window_obs,
+    scale_estimator_ = std::make_unique<ScaleEstimator>(rig, std::min(options.max_landmarks, window_obs), window_obs,
                                                         map_.keyframeCapacity(), options.scale_factor, options.levels);
     scale_filter_ = std::make_unique<ScaleFilter>();
   }
@@ -69,6 +68,8 @@ Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_featu
 Odometry::~Odometry() = default;
 
 Rig Odometry::refinedRig() const { return mapper_->refinedRig(); }
+
+const RigState& Odometry::rigState() const { return mapper_->rigState(); }
 
 uint64_t Odometry::backendThreadAllocations() const { return mapper_->backendThreadAllocations(); }
 
@@ -83,16 +84,18 @@ void Odometry::resetMap() {
   have_velocity_ = false;
 }
 
-void Odometry::useExtrinsic(int cam, const SE3& T_b_c) {
-  rig_.cameras[cam].T_b_c = T_b_c;  // the map, projection search, mapper and initializer read it through rig_
-  ransac_.setExtrinsic(cam, T_b_c);
-  refiner_.setExtrinsic(cam, T_b_c);
+void Odometry::followRig() {
+  if (!tracking_rig_.follow(mapper_->rigState())) return;
+  for (int c = 0; c < tracking_rig_.cameras(); ++c) {
+    ransac_.setExtrinsic(c, tracking_rig_.T_b_c(c));
+    refiner_.setExtrinsic(c, tracking_rig_.T_b_c(c));
+  }
 }
 
 void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
   processFrame(frame, frame_index, out);
   // As of the end of the frame: a scale that converged in it already rescaled this pose.
-  out.metric = scale_converged_ && rig_.size() > 1;
+  out.metric = mapper_->rigState().metric();
 }
 
 void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
@@ -103,6 +106,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   out.sequence = frame_index;
   frame_index_ = frame_index;
   flush();  // the previous keyframe's solve, before this frame reads the map
+  followRig();
   const auto start = Clock::now();
   const double flushed_ms = timing_.mapping_ms + timing_.backend_ms;
 
@@ -138,11 +142,9 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   if (extrinsic_check_) {
     // No solve runs now (flush() came first): the back-end's estimate may be replaced.
     SE3 T_b_c;
-    const int cam = extrinsic_check_->check(map_, search_, frame, matches_, T_w_b, T_b_c);
+    const int cam = extrinsic_check_->check(map_, search_, mapper_->rigState().rig(), frame, matches_, T_w_b, T_b_c);
     if (cam >= 0) {
-      useExtrinsic(cam, T_b_c);
-      mapper_->setExtrinsic(cam, T_b_c);
-      reestimated_[cam] = 1;
+      mapper_->reestimateExtrinsic(cam, T_b_c);
       ++stats_.extrinsic_reestimations;
     }
   }
@@ -189,7 +191,7 @@ void Odometry::flush() {
   const bool applied = mapper_->finishOptimize();  // waits for the solve when it runs on the back-end thread
   if (applied && options_.refine_extrinsics) {
     // Tracking continues with the extrinsics the back-end refined, as it does with its poses and points.
-    for (int c = 0; c < rig_.size(); ++c) useExtrinsic(c, mapper_->extrinsic(c));
+    mapper_->adoptSolvedExtrinsics();
   }
   timing_.backend_ms += msSince(start);
   finishKeyframe(slot);  // its culling counts as mapping
@@ -237,9 +239,11 @@ void Odometry::estimateScale() {
   // know it to 20% or it has converged (the search re-fits the window at every factor it tries: the range is most
   // of its cost).
   constexpr double kKnownSigma = 0.2, kKnownRatio = 2.0;
-  const double ratio = scale_converged_ || scale_filter_->sigma() <= kKnownSigma
+  const bool scale_converged = mapper_->rigState().scaleConverged();
+  const double ratio = scale_converged || scale_filter_->sigma() <= kKnownSigma
                            ? std::min(kKnownRatio, options_.scale_search_ratio)
                            : options_.scale_search_ratio;
+  scale_estimator_->follow(mapper_->rigState());
   const ScaleEstimate e = scale_estimator_->estimate(map_, ratio);
   ++stats_.scale_estimates;
   if (!e.ok) return;
@@ -260,11 +264,11 @@ void Odometry::estimateScale() {
   // A correction 3 sigma away from 1 is applied at any time: before convergence it brings the arbitrary unit near
   // the metric one (the windows' Gauss-Newton then starts in the basin; a unit 8x off left most windows without
   // an estimate), the poses staying flagged unscaled until the combined sigma reaches the bound.
-  const bool converges = !scale_converged_ && sigma <= options_.scale_max_sigma &&
+  const bool converges = !scale_converged && sigma <= options_.scale_max_sigma &&
                          scale_filter_->rotationSpan() >= options_.scale_min_rotation_deg * M_PI / 180.0;
   // Once converged the map follows the combined estimate as the unit drifts, whenever it is 2 sigma off (1 sigma:
   // about the same result, 55 rescales in seven runs of the rendered 10 cm rig against 42).
-  const double significant = scale_converged_ ? 2.0 : 3.0;
+  const double significant = scale_converged ? 2.0 : 3.0;
   if (!converges && !(std::abs(x) > significant * sigma)) return;
   // The whole live map, the window and the motion model take the new unit at once.
   const double s = std::exp(x);
@@ -276,7 +280,7 @@ void Odometry::estimateScale() {
   scale_filter_->applied();
   ++stats_.scale_rescales;
   if (converges) {
-    scale_converged_ = true;
+    mapper_->setScaleStatus(ScaleStatus::Metric);
     scale_filter_->setDrift(options_.scale_drift_per_keyframe);
     stats_.scale_converged_frame = static_cast<int64_t>(frame_index_);
   }
@@ -288,6 +292,8 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   int kf_new = -1;
   last_init_reference_ = -1;
   bool metric = true;
+  const int cams = mapper_->rigState().cameras();
+  initializer_->follow(mapper_->rigState());
   if (initializer_->oneFrameReady(frame)) {
     // Enough metric multi-view features: the map starts from this frame alone.
     resetMap();
@@ -316,7 +322,7 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
         mapper_->optimize(kf_new);
         timing_.backend_ms = msSince(be_start);
         last_init_reference_ = static_cast<int64_t>(ref_index);
-        metric = initializer_->lastMetric() || rig_.size() == 1;  // one camera: never metric, nothing to wait for
+        metric = initializer_->lastMetric() || cams == 1;  // one camera: never metric, nothing to wait for
       }
     }
   }
@@ -326,14 +332,14 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   }
   initializer_->reset();
   initialized_ = true;
-  scale_converged_ = metric;
+  mapper_->setScaleStatus(cams == 1 ? ScaleStatus::Monocular : metric ? ScaleStatus::Metric : ScaleStatus::Unscaled);
   scale_free_start_ = !metric;
   // A map that starts up to scale keeps its unit (the window's summed keyframe distances held, or its two oldest
   // keyframes fixed as for one camera: OdometryOptions::hold_window_scale) and only the estimates of
   // estimateScale() change it. A free window random-walked its scale wherever no turn constrained it: the 33 cm
   // rig's map shrank to a tenth on a straight stretch, the 10 cm rig lost track. resetMap() lets it go.
-  if (!metric && rig_.size() > 1) mapper_->holdScale(true);
-  mapper_->setSceneReferencedPoints(!metric || rig_.size() == 1);
+  if (!metric && cams > 1) mapper_->holdScale(true);
+  mapper_->setSceneReferencedPoints(!metric || cams == 1);
   if (scale_filter_) scale_filter_->reset();
   ++stats_.initializations;
   ++stats_.keyframes;
@@ -402,7 +408,7 @@ Odometry::TrackResult Odometry::track(const FrameFeatures& frame, uint64_t frame
       map_.refreshLiveList();
       const int32_t* slots = attempt == 0 ? last_tracked_.data() : map_.liveLandmarkSlots();
       const int n = attempt == 0 ? last_tracked_count_ : map_.liveLandmarkCount();
-      found = search_.search(map_, slots, n, predicted, frame, params, matches_, false);
+      found = search_.search(map_, tracking_rig_.rig(), slots, n, predicted, frame, params, matches_, false);
     } else {
       found = searchNewestKeyframeByDescriptor(frame);
     }
@@ -423,13 +429,13 @@ Odometry::TrackResult Odometry::track(const FrameFeatures& frame, uint64_t frame
     matches_.reset(frame);
     map_.refreshLiveList();
     params.radius_px = options_.track_radius_px;
-    search_.search(map_, map_.liveLandmarkSlots(), map_.liveLandmarkCount(), coarse, frame, params, matches_, false);
+    search_.search(map_, tracking_rig_.rig(), map_.liveLandmarkSlots(), map_.liveLandmarkCount(), coarse, frame, params, matches_, false);
   }
 
   // 3. The local map, projected with the coarse pose into every camera, then the final refinement.
   map_.refreshLiveList();
   params.radius_px = options_.local_map_radius_px;
-  search_.search(map_, map_.liveLandmarkSlots(), map_.liveLandmarkCount(), coarse, frame, params, matches_, true);
+  search_.search(map_, tracking_rig_.rig(), map_.liveLandmarkSlots(), map_.liveLandmarkCount(), coarse, frame, params, matches_, true);
   const int refined = poseFromMatches(frame, coarse, false, T_w_b);
   if (refined >= options_.min_tracked) {
     inliers = refined;
@@ -476,7 +482,7 @@ int Odometry::poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool
       PoseObservation& o = observations_[n];
       o.camera = c;
       o.pixel = Vec2(kp.x, kp.y);
-      o.ray = bodyRay(rig_, c, frame.bearings[c][k]);
+      o.ray = bodyRay(tracking_rig_.rig(), c, frame.bearings[c][k]);
       o.point_w = map_.landmark(lm).p_w;
       o.sigma_px = octave_scale_[kp.octave];
       observation_refs_[n] = KeypointRef{static_cast<int16_t>(c), k};

@@ -12,6 +12,7 @@
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/projection_search.hpp"
+#include "mcslam/odometry/rig_state.hpp"
 
 namespace mcslam {
 
@@ -58,12 +59,14 @@ class LocalMapper {
   // may change (a rig without overlap). No solve may be in flight; reset() lets it go.
   void holdScale(bool hold);
   Rig refinedRig() const;
-  // The back-end's current estimate of camera `cam`'s extrinsic (the rig's when there is no back-end). Not while
-  // a solve runs.
-  const SE3& extrinsic(int cam) const;
-  // Replaces that estimate; the camera's calibration prior is dropped (SlidingWindowSolver::setExtrinsic). False
-  // when the extrinsic is not refined or a solve runs.
-  bool setExtrinsic(int cam, const SE3& T_b_c);
+  // The rig state tracking and the front-end follow (this is its producer).
+  const RigState& rigState() const { return rig_state_; }
+  // The last applied solve's extrinsics become the rig state's (with extrinsic refinement on).
+  void adoptSolvedExtrinsics();
+  // Camera `cam`'s extrinsic re-estimated (ExtrinsicCheck): the rig state's and the back-end's estimate, whose
+  // calibration prior is then dropped (SlidingWindowSolver::setExtrinsic). No solve may be in flight.
+  void reestimateExtrinsic(int cam, const SE3& T_b_c);
+  void setScaleStatus(ScaleStatus s) { rig_state_.setScale(s); }
   // Heap allocations made by the back-end thread, all solves (0 without it): for the fixed-memory tests.
   uint64_t backendThreadAllocations() const;
   uint64_t backendSolves() const { return backend_solves_; }
@@ -78,7 +81,7 @@ class LocalMapper {
   // Median inverse distance (1/m) from keyframe `slot` to the landmarks it observes; 0 with too few of them.
   double sceneInverseDepth(int slot);
 
-  const Rig& rig_;       // the odometry's: its extrinsics follow the estimates
+  RigState rig_state_;   // with refinement on, its extrinsics follow the estimates
   Rig calibration_;      // the back-end's prior, also for a new window after a reset
   std::vector<uint8_t> calibration_dropped_;  // per camera: setExtrinsic() showed its calibration wrong
   OdometryOptions options_;

@@ -15,6 +15,7 @@
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/pose_estimate.hpp"
 #include "mcslam/odometry/projection_search.hpp"
+#include "mcslam/odometry/rig_state.hpp"
 
 namespace mcslam {
 
@@ -71,14 +72,17 @@ class Odometry {
   const Map& map() const { return map_; }
   // The rig with the extrinsics the back-end refined (the calibration when refinement is off).
   Rig refinedRig() const;
-  // The rig tracking uses: with refinement on, the extrinsics as of the last applied solve or per-camera check.
-  const Rig& trackingRig() const { return rig_; }
+  // The rig state as of the end of the last frame (tracking takes it at the start of the next one): with
+  // refinement on, the extrinsics as of the last applied solve or per-camera check. A view for the call: a
+  // consumer keeps a copy (RigState::follow()).
+  const RigState& rigState() const;
+  const Rig& trackingRig() const { return rigState().rig(); }
   // Whether the per-camera check found camera `cam`'s calibration wrong and re-estimated it.
-  bool extrinsicReestimated(int cam) const { return reestimated_[cam] != 0; }
+  bool extrinsicReestimated(int cam) const { return rigState().reestimated(cam); }
   bool initialized() const { return initialized_; }
   // False while a map started up to scale (rig without overlap) waits for its window to fix the scale: poses
   // until then have an arbitrary unit. True for a metric start and for one camera (whose scale never is).
-  bool scaleConverged() const { return scale_converged_; }
+  bool scaleConverged() const { return rigState().scaleConverged(); }
   // Heap allocations made on the back-end thread so far (0 when the solve runs inline).
   uint64_t backendThreadAllocations() const;
   // Frame index of the reference frame of the last initialization when it used two frames (the frames
@@ -104,9 +108,9 @@ class Odometry {
   void estimateScale();
   double windowTurn() const;  // largest rotation (rad) of a back-end window keyframe from the window's oldest
   int searchNewestKeyframeByDescriptor(const FrameFeatures& frame);
-  void useExtrinsic(int cam, const SE3& T_b_c);  // in everything that tracks and maps
+  void followRig();  // tracking takes the rig state at the start of a frame
 
-  Rig rig_;  // with refinement on, its extrinsics follow the estimates (the back-end keeps the calibration as prior)
+  RigState tracking_rig_;  // tracking's copy of the mapper's rig state
   OdometryOptions options_;
   int capacity_;
   Map map_;
@@ -117,7 +121,6 @@ class Odometry {
   std::unique_ptr<Initializer> initializer_;
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<ExtrinsicCheck> extrinsic_check_;  // with refinement on and several cameras
-  std::vector<uint8_t> reestimated_;                 // per camera
   std::unique_ptr<ScaleEstimator> scale_estimator_;  // null for one camera
   std::unique_ptr<ScaleFilter> scale_filter_;
 
@@ -139,7 +142,6 @@ class Odometry {
   int pending_keyframe_ = -1;     // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
   int64_t last_init_reference_ = -1;
-  bool scale_converged_ = true;
   bool scale_free_start_ = false;  // the map started up to scale: its scale is estimated at keyframes
   double rotation_travelled_ = 0;  // radians the rig has turned through since the start, frame to frame
   uint64_t frame_index_ = 0;      // of the frame being processed

@@ -26,6 +26,7 @@
 
 #include "mcslam/backend/robust_loss.hpp"
 #include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/rig_state.hpp"
 
 namespace mcslam {
 
@@ -49,6 +50,8 @@ class ScaleEstimator {
   // max_keyframes: the map's keyframe capacity. All scratch is allocated here: estimate() allocates nothing.
   ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
                  float octave_scale_factor, int levels);
+  // Takes the current extrinsics by value (estimate() uses them); allocates nothing.
+  void follow(const RigState& state) { rig_ = state.rig(); }
 
   // Uses the map's newest live keyframes (up to kMaxKeyframes) and the landmarks that kMinLandmarkKeyframes of
   // them observe. `max_ratio` bounds the coarse search: s in [1 / max_ratio, max_ratio]; at most 1, the
@@ -85,7 +88,7 @@ class ScaleEstimator {
   // Block of window keyframe w in the reduced pose system (-1: the oldest, held).
   int freeIndex(int w) const { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); }
 
-  const Rig& rig_;
+  Rig rig_;  // a copy: follow() moves its extrinsics
   backend::RobustLoss loss_;
   std::vector<double> octave_sigma_;
   std::vector<SE3> T_c_b_;     // per camera, from the rig at the start of estimate() (its extrinsics may follow
