@@ -41,7 +41,7 @@ ExtrinsicCheck::~ExtrinsicCheck() = default;
 
 void ExtrinsicCheck::reset() { std::fill(sample_count_.begin(), sample_count_.end(), 0); }
 
-int ExtrinsicCheck::check(Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
+int ExtrinsicCheck::check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
                           const SE3& T_w_b, SE3& T_b_c) {
   const int cam = suspectCamera(frame, matches);
   if (cam < 0) return -1;
@@ -82,7 +82,7 @@ int ExtrinsicCheck::suspectCamera(const FrameFeatures& frame, const FrameMatches
   return suspect;
 }
 
-bool ExtrinsicCheck::sample(int cam, Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
+bool ExtrinsicCheck::sample(int cam, const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
                             const SE3& T_w_b, Sample& out) {
   // The local map into this camera alone, with the tracking's wide window (its second attempt's radius).
   ProjectionSearchParams p;
@@ -93,8 +93,7 @@ bool ExtrinsicCheck::sample(int cam, Map& map, ProjectionSearch& search, const R
   p.radius_px = options_.track_radius_px * options_.wide_radius_factor;
   p.camera = cam;
   wide_.reset(frame);
-  map.refreshLiveList();
-  search.search(map, rig, map.liveLandmarkSlots(), map.liveLandmarkCount(), T_w_b, frame, p, wide_, false);
+  search.search(map, rig, map.liveLandmarkSlots(), map.liveLandmarkCount(), T_w_b, frame, p, wide_, nullptr);
   int n = 0;
   for (int k = 0; k < frame.sets[cam].count; ++k) {
     const int lm = wide_.landmarkOf(cam, k);

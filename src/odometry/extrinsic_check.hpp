@@ -6,6 +6,7 @@
 // the camera's pose is solved alone (P3P RANSAC and refinement through its lens model). The body-from-camera
 // implied by several frames, when they agree, becomes the estimate tracking and the back-end start from (the
 // calibration stays the back-end's prior). Every threshold is in pixels against the tracking's inlier gate.
+// The map's live list must be fresh (the odometry refreshes it before tracking).
 #include <memory>
 #include <vector>
 
@@ -25,7 +26,7 @@ class ExtrinsicCheck {
   // After frame `frame` was tracked at T_w_b with inlier matches `matches` (`search` prepared for the frame),
   // with the current extrinsics `rig` (a view for the call). Returns the camera whose extrinsic estimate should
   // become T_b_c, or -1.
-  int check(Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
+  int check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
             const SE3& T_w_b, SE3& T_b_c);
   void reset();  // the map was dropped: its samples with it
 
@@ -38,7 +39,7 @@ class ExtrinsicCheck {
     double depth = 0;  // median depth of the camera's inliers, metres
   };
   int suspectCamera(const FrameFeatures& frame, const FrameMatches& matches);
-  bool sample(int cam, Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
+  bool sample(int cam, const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
               const SE3& T_w_b, Sample& out);
   bool decide(int cam, const Rig& rig, SE3& T_b_c);
   // RMS pixel distance, over a few points of camera `cam`'s image at `depth`, between seeing them through

@@ -529,7 +529,7 @@ uint64_t LocalMapper::backendThreadAllocations() const {
   return worker_->allocations();
 }
 
-int LocalMapper::cull(int newest_slot) {
+int LocalMapper::cull(int newest_slot, const LandmarkTracks& tracks) {
   const int64_t newest_id = map_.keyframe(newest_slot).id;
   map_.refreshLiveList();
   int erased = 0;
@@ -537,8 +537,9 @@ int LocalMapper::cull(int newest_slot) {
     const int lm = map_.liveLandmarkSlots()[i];
     const Landmark& l = map_.landmark(lm);
     if (!l.alive) continue;
-    const bool rarely_found = l.visible >= static_cast<uint32_t>(options_.cull_min_visible) &&
-                              l.found < options_.cull_min_found_ratio * l.visible;
+    const LandmarkTrack& t = tracks.peek(map_, lm);
+    const bool rarely_found = t.visible >= static_cast<uint32_t>(options_.cull_min_visible) &&
+                              t.found < options_.cull_min_found_ratio * t.visible;
     const bool never_confirmed = !l.metric && l.created_keyframe_id <= newest_id - 3 && map_.observingKeyframes(lm) < 2;
     if (l.obs_count == 0 || rarely_found || never_confirmed) {
       backendRemoveLandmark(lm);

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "mcslam/features/octave_scales.hpp"
+#include "mcslam/odometry/landmark_tracks.hpp"
 
 namespace mcslam {
 
@@ -55,8 +56,9 @@ void ProjectionSearch::prepare(const FrameFeatures& frame) {
   for (int c = 0; c < frame.cameras(); ++c) grids_[c].build(frame.sets[c]);
 }
 
-int ProjectionSearch::search(Map& map, const Rig& rig, const int32_t* slots, int n, const SE3& T_w_b, const FrameFeatures& frame,
-                             const ProjectionSearchParams& p, FrameMatches& matches, bool count_visible) {
+int ProjectionSearch::search(const Map& map, const Rig& rig, const int32_t* slots, int n, const SE3& T_w_b,
+                             const FrameFeatures& frame, const ProjectionSearchParams& p, FrameMatches& matches,
+                             LandmarkTracks* count_visible) {
   const int cams = frame.cameras();
   for (int c = 0; c < cams; ++c) T_c_w_[c] = (T_w_b * rig.T_b_c(c)).inverse();
   const float log_scale = std::log(p.scale_factor);
@@ -65,7 +67,7 @@ int ProjectionSearch::search(Map& map, const Rig& rig, const int32_t* slots, int
   int made = 0;
   for (int i = 0; i < n; ++i) {
     const int lm = slots[i];
-    Landmark& l = map.landmark(lm);
+    const Landmark& l = map.landmark(lm);
     if (!l.alive) continue;
     bool visible = false;
     for (int c = c_begin; c < c_end; ++c) {
@@ -107,7 +109,7 @@ int ProjectionSearch::search(Map& map, const Rig& rig, const int32_t* slots, int
       if (best_octave == second_octave && !(best < p.ratio * second)) continue;
       if (matches.offer(c, best_kp, lm, best)) ++made;
     }
-    if (visible && count_visible) ++l.visible;
+    if (visible && count_visible) ++count_visible->of(map, lm).visible;
   }
   return made;
 }

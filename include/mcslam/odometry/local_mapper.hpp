@@ -9,6 +9,7 @@
 #include "mcslam/features/octave_scales.hpp"
 #include "mcslam/backend/sliding_window_solver.hpp"
 #include "mcslam/odometry/epipolar_band_index.hpp"
+#include "mcslam/odometry/landmark_tracks.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/projection_search.hpp"
@@ -47,8 +48,9 @@ class LocalMapper {
   bool finishOptimize();
   bool optimizing() const { return solving_; }
 
-  // Erases landmarks that are rarely found where predicted, or that never got a second keyframe.
-  int cull(int newest_slot);
+  // Erases landmarks that are rarely found where predicted (the tracker's counts, a view for the call), or that
+  // never got a second keyframe.
+  int cull(int newest_slot, const LandmarkTracks& tracks);
 
   void reset();
   // Multiplies every keyframe position and landmark, in the map and in the back-end's window, about `center`
