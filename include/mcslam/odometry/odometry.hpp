@@ -46,9 +46,10 @@ struct OdometryTiming {
 class ExtrinsicCheck;
 class Initializer;
 class LocalMapper;
-class ScaleEstimator;
-class ScaleFilter;
+class ScaleSupervisor;
+class TemporalTriangulator;
 class Tracker;
+class WindowBridge;
 
 class Odometry {
  public:
@@ -73,8 +74,6 @@ class Odometry {
   // consumer keeps a copy (RigState::follow()).
   const RigState& rigState() const;
   const Rig& trackingRig() const { return rigState().rig(); }
-  // Whether the per-camera check found camera `cam`'s calibration wrong and re-estimated it.
-  bool extrinsicReestimated(int cam) const { return rigState().reestimated(cam); }
   bool initialized() const { return initialized_; }
   // False while a map started up to scale (rig without overlap) waits for its window to fix the scale: poses
   // until then have an arbitrary unit. True for a metric start and for one camera (whose scale never is).
@@ -86,37 +85,42 @@ class Odometry {
   int64_t lastInitializationReference() const { return last_init_reference_; }
 
  private:
+  // The initialize state: a map from one frame (enough metric multi-view features) or from two.
   void initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
+  int initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_index);  // keyframe slot, -1: not yet
+  int initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, bool& metric);
+  // The map starts at keyframe `kf_new`: the track state.
+  void startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out);
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.
   void lose(uint64_t frame_index, int inliers, PoseEstimate& out);
   // A keyframe of the tracked frame: its landmarks, new points, and its back-end solve started.
   void makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers,
                     PoseEstimate& out);
+  // New landmarks across time for keyframe `slot` (TemporalTriangulator); returns how many.
+  int triangulateNew(int slot);
   void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
-  // Estimates the scale of a map started up to scale over its newest keyframes at every keyframe, and
-  // rescales the map when the combined estimate is certain (the first time: the scale has converged) or
-  // significantly off.
+  void clearMap();  // the map, the mapper's pending work and the window
+  // At a settled keyframe of a map started up to scale: the map, the window and the motion model take the unit
+  // the scale supervisor finds.
   void estimateScale();
-  double windowTurn() const;  // largest rotation (rad) of a back-end window keyframe from the window's oldest
 
   OdometryOptions options_;
-  int capacity_;
   Map map_;
   std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<Initializer> initializer_;
   std::unique_ptr<LocalMapper> mapper_;
+  std::unique_ptr<TemporalTriangulator> triangulator_;
+  std::unique_ptr<WindowBridge> bridge_;
   std::unique_ptr<ExtrinsicCheck> extrinsic_check_;  // with refinement on and several cameras
-  std::unique_ptr<ScaleEstimator> scale_estimator_;  // null for one camera
-  std::unique_ptr<ScaleFilter> scale_filter_;
+  std::unique_ptr<ScaleSupervisor> scale_;
 
   bool initialized_ = false;
   SE3 anchor_;                    // pose given to the next initialization (continuity after a loss)
   int pending_keyframe_ = -1;     // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
   int64_t last_init_reference_ = -1;
-  bool scale_free_start_ = false;  // the map started up to scale: its scale is estimated at keyframes
   uint64_t frame_index_ = 0;      // of the frame being processed
   OdometryStats stats_;
   OdometryTiming timing_;
