@@ -115,9 +115,8 @@ class ScaleEstimator {
 // independent, and of two that overlap in a turn the later usually holds more of it (its sigma falls from tens
 // of percent to a few as the turn enters the window): of overlapping windows only the most certain counts
 // (pending); it is fused with the earlier ones (committed) once a window sharing no keyframe with it arrives.
-// (Counting every window by its share of new keyframes instead kept the windows before a turn, which saw
-// little of it, at the weight of the turn's own: the combination crept 1.00 -> 1.05 while a turn's windows
-// said 1.16 +- 2.5%, rendered 10 cm rig.) An estimate that disagrees with the combined one by more than 3 sigma
+// (Counting every window by its share of new keyframes instead would keep the windows before a turn, which saw
+// little of it, at the weight of the turn's own.) An estimate that disagrees with the combined one by more than 3 sigma
 // is dropped; when several in a row disagree, the map's scale has drifted (a straight stretch hides it) and the
 // combination restarts from the latest. Windows of one turn also share their scene and the map's history:
 // rotationSpan() says over how much rotation of the rig (radians travelled, `rotation` of add()) the combined
