@@ -2,6 +2,7 @@
 // tracker's per-landmark counts.
 #include <gtest/gtest.h>
 
+#include <random>
 #include <set>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/rig_state.hpp"
 #include "mcslam/odometry/scale_supervisor.hpp"
+#include "mcslam/odometry/window_bridge.hpp"
 #include "mcslam/odometry/odometry.hpp"
 #include "synthetic_sequence.hpp"
 
@@ -158,4 +160,67 @@ TEST(ScaleSupervisor, AMetricMapIsNeverRescaled) {
   const ScaleSupervisor::Rescale r = supervisor.onKeyframe(map, RigState(rig), 10.0, 7, stats);
   EXPECT_FALSE(r.apply);
   EXPECT_EQ(stats.scale_estimates, 0u);
+}
+
+// The window knows landmarks by their ids, not their slots: after slots were recycled (ids ahead of slots), a solve
+// still writes every landmark back to its own slot.
+TEST(WindowBridge, SolvesReachLandmarksByIdAfterSlotReuse) {
+  const Rig rig = test::nonOverlappingRig3();
+  OdometryOptions options;
+  options.backend_thread = false;
+  constexpr int kLandmarks = 300;
+  Map map(rig, 400, options.max_keyframes, kLandmarks);
+  for (int round = 0; round < 3; ++round) {  // recycle every slot: ids now run ahead of slots
+    for (int i = 0; i < kLandmarks; ++i) map.createLandmark(Vec3::Zero(), Descriptor{}, 0);
+    for (int i = 0; i < kLandmarks; ++i) map.eraseLandmark(i);
+  }
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<SE3> poses;
+  for (int k = 0; k < 3; ++k) {
+    poses.emplace_back(Eigen::AngleAxisd(0.1 * k, Vec3::UnitY()).toRotationMatrix(), Vec3(0.1 * k, 0, 0.3 * k));
+  }
+  std::vector<int> kfs;
+  for (int k = 0; k < 3; ++k) {
+    const int s = map.createKeyframe();
+    map.keyframe(s).T_w_b = poses[k];
+    for (int c = 0; c < rig.size(); ++c) map.keyframe(s).features.sets[c].count = 0;
+    kfs.push_back(s);
+  }
+  std::vector<Vec3> truth(kLandmarks);
+  for (int i = 0; i < kLandmarks; ++i) {
+    const Vec3 p = Vec3(0, 0, 0.5) + (3.0 + u(rng)) * Vec3(u(rng), 0.3 * u(rng), u(rng)).normalized();
+    const int lm = map.createLandmark(p + Vec3(0.02, -0.01, 0.015), Descriptor{}, 0);  // off the truth
+    ASSERT_GE(lm, 0);
+    ASSERT_NE(map.landmark(lm).id, lm);
+    truth[lm] = p;
+    for (int k = 0; k < 3; ++k) {
+      for (int c = 0; c < rig.size(); ++c) {
+        const Vec3 p_c = (poses[k] * rig.T_b_c(c)).inverse() * p;
+        Vec2 uv;
+        if (p_c.z() < 0.3 || !rig.model(c).project(p_c, uv) || !rig.model(c).inImage(uv)) continue;
+        FeatureSet& set = map.keyframe(kfs[k]).features.sets[c];
+        if (set.count == set.capacity()) continue;
+        Keypoint kp;
+        kp.x = static_cast<float>(uv.x());
+        kp.y = static_cast<float>(uv.y());
+        kp.octave = 0;
+        set.keypoints[set.count] = kp;
+        map.addObservation(lm, kfs[k], c, set.count);
+        ++set.count;
+      }
+    }
+  }
+  WindowBridge bridge(rig, options, 400);
+  for (const int s : kfs) bridge.optimize(map, s);  // the first, alone, has nothing to solve
+  EXPECT_EQ(bridge.solves(), 3u);
+  int in_window = 0, closer = 0;
+  for (int lm = 0; lm < kLandmarks; ++lm) {
+    const Landmark& l = map.landmark(lm);
+    if (!l.alive || !l.in_backend) continue;
+    ++in_window;
+    closer += (l.p_w - truth[lm]).norm() < 0.5 * Vec3(0.02, -0.01, 0.015).norm() ? 1 : 0;
+  }
+  EXPECT_GT(in_window, 40);
+  EXPECT_GT(closer, 0.9 * in_window);  // written back to their own slots
 }
