@@ -17,7 +17,7 @@ constexpr double kCollapsedShare = 0.25;
 }  // namespace
 
 ExtrinsicCheck::ExtrinsicCheck(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
-    : rig_(rig), options_(options), gate_px_(std::sqrt(AbsolutePoseRansacOptions{}.chi2_threshold)) {
+    : options_(options), gate_px_(std::sqrt(AbsolutePoseRansacOptions{}.chi2_threshold)) {
   const int cams = rig.size();
   AbsolutePoseRansacOptions ro;
   // A lone camera fixes six degrees of freedom from its own points: twice the rig's minimum.
@@ -41,17 +41,17 @@ ExtrinsicCheck::~ExtrinsicCheck() = default;
 
 void ExtrinsicCheck::reset() { std::fill(sample_count_.begin(), sample_count_.end(), 0); }
 
-int ExtrinsicCheck::check(Map& map, ProjectionSearch& search, const FrameFeatures& frame, const FrameMatches& matches,
+int ExtrinsicCheck::check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
                           const SE3& T_w_b, SE3& T_b_c) {
   const int cam = suspectCamera(frame, matches);
   if (cam < 0) return -1;
   Sample s;
-  if (!sample(cam, map, search, frame, T_w_b, s)) return -1;
+  if (!sample(cam, map, search, rig, frame, T_w_b, s)) return -1;
   // The newest kSamples, oldest overwritten. They are absolute extrinsics: the back-end's small moves of the
   // estimate between frames do not invalidate them.
   samples_[cam][sample_count_[cam] % kSamples] = s;
   ++sample_count_[cam];
-  return decide(cam, T_b_c) ? cam : -1;
+  return decide(cam, rig, T_b_c) ? cam : -1;
 }
 
 int ExtrinsicCheck::suspectCamera(const FrameFeatures& frame, const FrameMatches& matches) {
@@ -82,7 +82,7 @@ int ExtrinsicCheck::suspectCamera(const FrameFeatures& frame, const FrameMatches
   return suspect;
 }
 
-bool ExtrinsicCheck::sample(int cam, Map& map, ProjectionSearch& search, const FrameFeatures& frame,
+bool ExtrinsicCheck::sample(int cam, const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
                             const SE3& T_w_b, Sample& out) {
   // The local map into this camera alone, with the tracking's wide window (its second attempt's radius).
   ProjectionSearchParams p;
@@ -93,8 +93,7 @@ bool ExtrinsicCheck::sample(int cam, Map& map, ProjectionSearch& search, const F
   p.radius_px = options_.track_radius_px * options_.wide_radius_factor;
   p.camera = cam;
   wide_.reset(frame);
-  map.refreshLiveList();
-  search.search(map, map.liveLandmarkSlots(), map.liveLandmarkCount(), T_w_b, frame, p, wide_, false);
+  search.search(map, rig, map.liveLandmarkSlots(), map.liveLandmarkCount(), T_w_b, frame, p, wide_, nullptr);
   int n = 0;
   for (int k = 0; k < frame.sets[cam].count; ++k) {
     const int lm = wide_.landmarkOf(cam, k);
@@ -109,7 +108,7 @@ bool ExtrinsicCheck::sample(int cam, Map& map, ProjectionSearch& search, const F
   }
   AbsolutePoseRansac& ransac = *ransac_[cam];
   if (n < ransac.options().min_inliers) return false;
-  const SE3 predicted = T_w_b * rig_.T_b_c(cam);
+  const SE3 predicted = T_w_b * rig.T_b_c(cam);
   const AbsolutePoseRansacResult r = ransac.estimate(std::span<const PoseObservation>(obs_.data(), n), &predicted);
   if (!r.ok()) return false;
   const SE3 T_c_w = r.T_w_b.inverse();
@@ -122,10 +121,10 @@ bool ExtrinsicCheck::sample(int cam, Map& map, ProjectionSearch& search, const F
   return true;
 }
 
-bool ExtrinsicCheck::decide(int cam, SE3& T_b_c) {
+bool ExtrinsicCheck::decide(int cam, const Rig& rig, SE3& T_b_c) {
   if (sample_count_[cam] < kSamples) return false;
   const std::vector<Sample>& s = samples_[cam];
-  const SE3& current = rig_.T_b_c(cam);
+  const SE3& current = rig.T_b_c(cam);
   // Component-wise median in the tangent space at the current estimate (robust to a wrong frame or two).
   Vec6 median;
   for (int j = 0; j < 6; ++j) {
@@ -140,19 +139,19 @@ bool ExtrinsicCheck::decide(int cam, SE3& T_b_c) {
   // A lone camera's translation shows only through parallax: a change that moves its points by less than the
   // gate at their median depth is not resolved by these frames (it trades off against the rotation), so the
   // current translation is kept and the back-end refines it once the points pass the gate again.
-  const CameraModel& model = rig_.model(cam);
+  const CameraModel& model = rig.model(cam);
   const double f = 0.5 * (model.fx() + model.fy());
   const bool translation_resolved = f * median.head<3>().norm() / depth > gate_px_;
   const SE3 full(current.R * so3Exp(median.tail<3>()), current.t + current.R * median.head<3>());
   const SE3 candidate(full.R, translation_resolved ? full.t : current.t);
   // The frames must agree: half of them within the inlier gate of their median. Then the candidate, known to
   // about gate / sqrt(kSamples), puts the camera's points back inside the gate.
-  for (int i = 0; i < kSamples; ++i) scratch_[i] = pixelShift(cam, full, s[i].T_b_c, depth);
+  for (int i = 0; i < kSamples; ++i) scratch_[i] = pixelShift(model, full, s[i].T_b_c, depth);
   const double spread = medianOf(scratch_, kSamples);
   if (!(spread < gate_px_)) return false;
   // And the correction must matter: it moves the camera's points by more than the gate (less, and the
   // back-end sees enough of them to refine the extrinsic on its own).
-  const double shift = pixelShift(cam, current, candidate, depth);
+  const double shift = pixelShift(model, current, candidate, depth);
   if (!(shift > gate_px_)) return false;
   const SE3 change = current.inverse() * candidate;
   spdlog::info("odometry: camera {} extrinsic re-estimated from {} frames: moved {:.1f} mm, {:.2f} deg "
@@ -163,8 +162,7 @@ bool ExtrinsicCheck::decide(int cam, SE3& T_b_c) {
   return true;
 }
 
-double ExtrinsicCheck::pixelShift(int cam, const SE3& a, const SE3& b, double depth) const {
-  const CameraModel& model = rig_.model(cam);
+double ExtrinsicCheck::pixelShift(const CameraModel& model, const SE3& a, const SE3& b, double depth) const {
   const SE3 T_b_a = b.inverse() * a;
   const double w = model.width(), h = model.height();
   const Vec2 probes[5] = {{0.5 * w, 0.5 * h}, {0.25 * w, 0.25 * h}, {0.75 * w, 0.25 * h},

@@ -6,6 +6,7 @@
 // the camera's pose is solved alone (P3P RANSAC and refinement through its lens model). The body-from-camera
 // implied by several frames, when they agree, becomes the estimate tracking and the back-end start from (the
 // calibration stays the back-end's prior). Every threshold is in pixels against the tracking's inlier gate.
+// The map's live list must be fresh (the odometry refreshes it before tracking).
 #include <memory>
 #include <vector>
 
@@ -18,13 +19,14 @@ namespace mcslam {
 
 class ExtrinsicCheck {
  public:
-  // rig: the tracking rig, read for its current extrinsics at every check.
+  // rig: the calibration (its lens models; nothing of it is kept).
   ExtrinsicCheck(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
   ~ExtrinsicCheck();
 
-  // After frame `frame` was tracked at T_w_b with inlier matches `matches` (`search` prepared for the frame).
-  // Returns the camera whose extrinsic estimate should become T_b_c, or -1.
-  int check(Map& map, ProjectionSearch& search, const FrameFeatures& frame, const FrameMatches& matches,
+  // After frame `frame` was tracked at T_w_b with inlier matches `matches` (`search` prepared for the frame),
+  // with the current extrinsics `rig` (a view for the call). Returns the camera whose extrinsic estimate should
+  // become T_b_c, or -1.
+  int check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
             const SE3& T_w_b, SE3& T_b_c);
   void reset();  // the map was dropped: its samples with it
 
@@ -37,13 +39,13 @@ class ExtrinsicCheck {
     double depth = 0;  // median depth of the camera's inliers, metres
   };
   int suspectCamera(const FrameFeatures& frame, const FrameMatches& matches);
-  bool sample(int cam, Map& map, ProjectionSearch& search, const FrameFeatures& frame, const SE3& T_w_b, Sample& out);
-  bool decide(int cam, SE3& T_b_c);
+  bool sample(int cam, const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
+              const SE3& T_w_b, Sample& out);
+  bool decide(int cam, const Rig& rig, SE3& T_b_c);
   // RMS pixel distance, over a few points of camera `cam`'s image at `depth`, between seeing them through
   // extrinsic a and through extrinsic b (infinite when one does not project).
-  double pixelShift(int cam, const SE3& a, const SE3& b, double depth) const;
+  double pixelShift(const CameraModel& model, const SE3& a, const SE3& b, double depth) const;
 
-  const Rig& rig_;
   OdometryOptions options_;
   OctaveScales octave_scale_{options_.scale_factor};
   double gate_px_;  // the tracking's inlier gate at octave 0: sqrt(chi-square 2 dof, 95%) sigmas of 1 px

@@ -71,7 +71,7 @@ int Initializer::matchToReference(const FrameFeatures& f) {
 RelativePoseOptions Initializer::relativePoseOptions(uint64_t frame_index) const {
   RelativePoseOptions ro;
   ro.seed = 1 + frame_index;
-  const double f_mean = 0.5 * (rig_.model(0).fx() + rig_.model(0).fy());
+  const double f_mean = 0.5 * (rig_.rig().model(0).fx() + rig_.rig().model(0).fy());
   ro.bearing_sigma_rad = 0.7 / f_mean;  // keypoints at the finest octave: ~0.7 px; inliers within 3 sigma
   ro.min_inliers = std::max(20, options_.init_min_matches / 2);
   return ro;
@@ -96,23 +96,23 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
     last_status_ = RelativePoseStatus::TooFewCorrespondences;
     return TwoFrame::Waiting;
   }
-  if (rig_.size() > 1 && f.mv_count == 0 && reference_.mv_count == 0) {
+  if (rig_.cameras() > 1 && f.mv_count == 0 && reference_.mv_count == 0) {
     last_metric_ = false;
     const RelativePoseResult r = upToScale(frame_index, T_ref_cur);
     last_status_ = r.status;
     return r.ok() ? TwoFrame::Ready : TwoFrame::Waiting;
   }
-  last_metric_ = rig_.size() > 1;
+  last_metric_ = rig_.cameras() > 1;
   const RelativePoseOptions ro = relativePoseOptions(frame_index);
   RelativePoseResult r;
-  if (rig_.size() == 1) {
+  if (rig_.cameras() == 1) {
     r = estimateCentralRelativePose(correspondences_, ro);
   } else {
-    r = estimateGeneralizedRelativePose(rig_, correspondences_, ro);
+    r = estimateGeneralizedRelativePose(rig_.rig(), correspondences_, ro);
   }
   last_status_ = r.status;
   if (!r.ok()) return TwoFrame::Waiting;
-  if (rig_.size() == 1) {
+  if (rig_.cameras() == 1) {
     // The central solver works in camera frames: bring the motion into the body frame.
     const SE3& T_b_c = rig_.T_b_c(0);
     T_ref_cur = T_b_c * r.T_1_2 * T_b_c.inverse();
@@ -126,7 +126,7 @@ RelativePoseResult Initializer::upToScale(uint64_t frame_index, SE3& T_ref_cur) 
   const RelativePoseOptions ro = relativePoseOptions(frame_index);
   RelativePoseResult best;
   int best_cam = -1;
-  for (int c = 0; c < rig_.size(); ++c) {
+  for (int c = 0; c < rig_.cameras(); ++c) {
     camera_matches_.clear();
     for (const RelativeCorrespondence& m : correspondences_) {
       if (m.camera1 == c) camera_matches_.push_back(m);

@@ -8,6 +8,11 @@ namespace mcslam {
 Map::Map(const Rig& rig, int max_features_per_camera, int max_keyframes, int max_landmarks)
     : landmarks_(max_landmarks), free_landmarks_(max_landmarks), live_list_(max_landmarks), keyframes_(max_keyframes),
       medoid_scratch_(kMaxLandmarkObservations) {
+  size_t n = 16;
+  while (n < static_cast<size_t>(max_landmarks) * 2) n <<= 1;  // load factor at most 1/2
+  id_keys_.assign(n, -1);
+  id_slots_.assign(n, -1);
+  id_mask_ = n - 1;
   const int cameras = rig.size();
   for (Keyframe& kf : keyframes_) {
     kf.features.allocate(cameras, max_features_per_camera);
@@ -18,6 +23,7 @@ Map::Map(const Rig& rig, int max_features_per_camera, int max_keyframes, int max
 
 void Map::clear() {
   for (Landmark& l : landmarks_) l.alive = false;
+  std::fill(id_slots_.begin(), id_slots_.end(), -1);
   for (Keyframe& k : keyframes_) k.alive = false;
   free_landmark_count_ = static_cast<int>(landmarks_.size());
   for (int i = 0; i < free_landmark_count_; ++i) free_landmarks_[i] = free_landmark_count_ - 1 - i;
@@ -32,7 +38,8 @@ int Map::createLandmark(const Vec3& p_w, const Descriptor& d, int64_t keyframe_i
   Landmark& l = landmarks_[slot];
   l = Landmark{};
   l.alive = true;
-  l.id = nextLandmarkId();
+  l.id = next_landmark_id_++;
+  indexId(l.id, slot);
   l.p_w = p_w;
   l.descriptor = d;
   l.created_keyframe_id = keyframe_id;
@@ -50,9 +57,49 @@ void Map::eraseLandmark(int slot) {
   }
   l.alive = false;
   l.obs_count = 0;
+  unindexId(l.id);
   free_landmarks_[free_landmark_count_++] = slot;
   --live_landmarks_;
   live_list_dirty_ = true;
+}
+
+size_t Map::idHome(int64_t id) const {
+  const uint64_t x = static_cast<uint64_t>(id) * 0x9E3779B97F4A7C15ull;  // Fibonacci hashing
+  return (x ^ (x >> 29)) & id_mask_;
+}
+
+int Map::landmarkSlotOf(int64_t id) const {
+  for (size_t i = idHome(id);; i = (i + 1) & id_mask_) {
+    if (id_slots_[i] < 0) return -1;
+    if (id_keys_[i] == id) return id_slots_[i];
+  }
+}
+
+void Map::indexId(int64_t id, int slot) {
+  size_t i = idHome(id);
+  while (id_slots_[i] >= 0) i = (i + 1) & id_mask_;
+  id_keys_[i] = id;
+  id_slots_[i] = slot;
+}
+
+void Map::unindexId(int64_t id) {
+  size_t i = idHome(id);
+  for (;; i = (i + 1) & id_mask_) {
+    if (id_slots_[i] < 0) return;
+    if (id_keys_[i] == id) break;
+  }
+  // Entries after the hole whose probe path crosses it move back into it.
+  size_t hole = i;
+  for (size_t j = (i + 1) & id_mask_; id_slots_[j] >= 0; j = (j + 1) & id_mask_) {
+    const size_t h = idHome(id_keys_[j]);
+    const bool movable = hole <= j ? (h <= hole || h > j) : (h <= hole && h > j);
+    if (movable) {
+      id_keys_[hole] = id_keys_[j];
+      id_slots_[hole] = id_slots_[j];
+      hole = j;
+    }
+  }
+  id_slots_[hole] = -1;
 }
 
 void Map::rebuildLiveList() {

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "mcslam/features/octave_scales.hpp"
+#include "mcslam/odometry/landmark_tracks.hpp"
 
 namespace mcslam {
 
@@ -44,7 +45,7 @@ bool FrameMatches::offer(int cam, int kp, int lm, int distance) {
   return true;
 }
 
-ProjectionSearch::ProjectionSearch(const Rig& rig, int max_features_per_camera) : rig_(rig), T_c_w_(rig.size()) {
+ProjectionSearch::ProjectionSearch(const Rig& rig, int max_features_per_camera) : T_c_w_(rig.size()) {
   for (const RigCamera& c : rig.cameras) {
     grids_.emplace_back(c.model.width(), c.model.height(), 24, max_features_per_camera);
     cos_field_.push_back(std::cos(std::min(M_PI, c.model.imageHalfAngle() + M_PI / 180.0)));  // a degree of margin
@@ -55,17 +56,18 @@ void ProjectionSearch::prepare(const FrameFeatures& frame) {
   for (int c = 0; c < frame.cameras(); ++c) grids_[c].build(frame.sets[c]);
 }
 
-int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T_w_b, const FrameFeatures& frame,
-                             const ProjectionSearchParams& p, FrameMatches& matches, bool count_visible) {
+int ProjectionSearch::search(const Map& map, const Rig& rig, const int32_t* slots, int n, const SE3& T_w_b,
+                             const FrameFeatures& frame, const ProjectionSearchParams& p, FrameMatches& matches,
+                             LandmarkTracks* count_visible) {
   const int cams = frame.cameras();
-  for (int c = 0; c < cams; ++c) T_c_w_[c] = (T_w_b * rig_.T_b_c(c)).inverse();
+  for (int c = 0; c < cams; ++c) T_c_w_[c] = (T_w_b * rig.T_b_c(c)).inverse();
   const float log_scale = std::log(p.scale_factor);
   const OctaveScales scales(p.scale_factor);
   const int c_begin = p.camera >= 0 ? p.camera : 0, c_end = p.camera >= 0 ? std::min(p.camera + 1, cams) : cams;
   int made = 0;
   for (int i = 0; i < n; ++i) {
     const int lm = slots[i];
-    Landmark& l = map.landmark(lm);
+    const Landmark& l = map.landmark(lm);
     if (!l.alive) continue;
     bool visible = false;
     for (int c = c_begin; c < c_end; ++c) {
@@ -73,7 +75,7 @@ int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T
       const Vec3 p_c = T_c_w_[c] * l.p_w;
       if (p_c.z() < cos_field_[c] * p_c.norm()) continue;  // outside the camera's field of view
       Vec2 uv;
-      const CameraModel& model = rig_.model(c);
+      const CameraModel& model = rig.model(c);
       if (!model.project(p_c, uv) || !model.inImage(uv, 2.0)) continue;
       // Octave the point should be found at, from its distance (ORB-SLAM's scale prediction).
       const double dist = p_c.norm();
@@ -107,7 +109,7 @@ int ProjectionSearch::search(Map& map, const int32_t* slots, int n, const SE3& T
       if (best_octave == second_octave && !(best < p.ratio * second)) continue;
       if (matches.offer(c, best_kp, lm, best)) ++made;
     }
-    if (visible && count_visible) ++l.visible;
+    if (visible && count_visible) ++count_visible->of(map, lm).visible;
   }
   return made;
 }

@@ -36,18 +36,14 @@ SlamPipeline::SlamPipeline(const Rig& rig, const PipelineConfig& config)
   // Two: one being prepared while the other is finished.
   for (int k = 0; k < 2; ++k) stages_.push_back(Stage{FrameFeatures(rig_.size(), config_.orb.max_features), 0, 0, {}});
   handover_ = effectiveOdometryOptions(config_, front_end_.overlap()).refine_extrinsics && rig_.size() > 1;
-  if (handover_) {
-    for (std::vector<SE3>& e : extrinsics_after_) {
-      for (const RigCamera& c : rig_.cameras) e.push_back(c.T_b_c);
-    }
-  }
+  if (handover_) rig_after_.assign(2, RigState(rig_));
 }
 
 void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing) {
   if (handover_) {
     if (features_computed_ >= 2) {  // the first two frames keep the calibration
-      const std::vector<SE3>& e = extrinsics_after_[features_computed_ % 2];
-      for (int c = 0; c < rig_.size(); ++c) front_end_.setBodyFromCamera(c, e[c]);
+      const RigState& s = rig_after_[features_computed_ % 2];
+      for (int c = 0; c < rig_.size(); ++c) front_end_.setBodyFromCamera(c, s.reestimated(c) ? s.T_b_c(c) : rig_.T_b_c(c));
     }
     ++features_computed_;
   }
@@ -60,10 +56,7 @@ void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Times
                          PipelineTiming& timing) {
   odometry_.process(features, sequence, out);
   if (handover_) {
-    std::vector<SE3>& e = extrinsics_after_[frames_tracked_ % 2];
-    for (int c = 0; c < rig_.size(); ++c) {
-      e[c] = odometry_.extrinsicReestimated(c) ? odometry_.trackingRig().T_b_c(c) : rig_.T_b_c(c);
-    }
+    rig_after_[frames_tracked_ % 2].follow(odometry_.rigState());  // by value, allocates nothing
     ++frames_tracked_;
   }
   out.t = t;

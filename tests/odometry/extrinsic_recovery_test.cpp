@@ -59,8 +59,9 @@ Outcome run(const Rig& truth, const Rig& calibration) {
     alloc::ThreadScope scope;
     odo.process(f, i, pose);
     // The front-end follows a re-estimated camera, as SlamPipeline hands it over.
+    const RigState& rig = odo.rigState();
     for (int c = 0; c < calibration.size(); ++c) {
-      if (odo.extrinsicReestimated(c)) matcher.setBodyFromCamera(c, odo.trackingRig().T_b_c(c));
+      if (rig.reestimated(c)) matcher.setBodyFromCamera(c, rig.T_b_c(c));
     }
     if (i >= so.warmup_frames) allocations += scope.count();
     if (pose.valid && pose.state == TrackingState::Tracking) estimate.push_back({pose.t, pose.T_w_b});

@@ -11,12 +11,15 @@
 #include "mcslam/features/frame_features.hpp"
 #include "mcslam/geometry/relative_pose.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
+#include "mcslam/odometry/rig_state.hpp"
 
 namespace mcslam {
 
 class Initializer {
  public:
   Initializer(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
+  // Takes the current rig state (its extrinsics) by value; the odometry calls it before feeding a frame.
+  void follow(const RigState& state) { rig_.follow(state); }
 
   // Multi-view features whose point is certain enough to become a landmark.
   static int usableMultiView(const FrameFeatures& f, double max_depth_sigma);
@@ -46,7 +49,7 @@ class Initializer {
   RelativePoseOptions relativePoseOptions(uint64_t frame_index) const;
 
  private:
-  const Rig& rig_;
+  RigState rig_;  // a copy, following the odometry's
   OdometryOptions options_;
   FrameFeatures reference_;
   uint64_t reference_index_ = 0;

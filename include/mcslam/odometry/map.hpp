@@ -1,7 +1,12 @@
 #pragma once
 // The local map of the odometry: a fixed pool of keyframes (their features and which landmark each
 // keypoint observes) and a fixed pool of landmarks (world point, representative descriptor, and the
-// keyframe keypoints that observe it). Slots are recycled; nothing is allocated after construction.
+// keyframe keypoints that observe it). Slots are recycled; ids are not (a landmark's id is unique over the run,
+// and it is the id the back-end's window knows it by). Nothing is allocated after construction.
+//
+// One writer per field: the local mapper creates keyframes and landmarks and keeps their appearance; the window
+// bridge writes the back-end's results (poses, positions, in_backend, frozen) and rescales. Tracking only reads
+// the map; what it counts per landmark lives in its LandmarkTracks.
 #include <cstdint>
 #include <vector>
 
@@ -20,16 +25,12 @@ struct LandmarkObservation {
 
 struct Landmark {
   bool alive = false;
-  int64_t id = -1;                 // unique over the run (the back-end's id)
+  int64_t id = -1;                 // unique over the run; the back-end's window knows the landmark by it
   Vec3 p_w = Vec3::Zero();
   Descriptor descriptor{};
   int obs_count = 0;
   LandmarkObservation obs[kMaxLandmarkObservations];
   int64_t created_keyframe_id = -1;
-  uint32_t visible = 0;            // frames it was predicted inside an image
-  uint32_t found = 0;              // frames it was matched
-  uint64_t matched_frame = ~0ull;  // last frame index it was counted as found in
-  uint64_t listed_frame = ~0ull;   // last frame index it was put on the tracked list
   float max_distance = 0;          // distances over which ORB can find it again (scale invariance)
   float min_distance = 0;
   bool in_backend = false;
@@ -61,6 +62,8 @@ class Map {
   const Landmark& landmark(int slot) const { return landmarks_[slot]; }
   int landmarkCapacity() const { return static_cast<int>(landmarks_.size()); }
   int liveLandmarks() const { return live_landmarks_; }
+  // Slot of the live landmark with this id, -1 when none.
+  int landmarkSlotOf(int64_t id) const;
   // Slots of the live landmarks in slot order, as of the last refreshLiveList().
   const int32_t* liveLandmarkSlots() const { return live_list_.data(); }
   int liveLandmarkCount() const { return live_list_count_; }
@@ -90,11 +93,14 @@ class Map {
   // Recomputes the representative descriptor (medoid of the observations) and the distance range.
   void updateLandmarkAppearance(int lm, const Rig& rig, float scale_factor, int levels);
 
-  int64_t nextLandmarkId() { return next_landmark_id_++; }
   int64_t nextKeyframeId() { return next_keyframe_id_++; }
 
  private:
   void rebuildLiveList();
+  // Live landmark id -> slot: open addressing, linear probing, deletion by backward shift; sized at construction.
+  size_t idHome(int64_t id) const;
+  void indexId(int64_t id, int slot);
+  void unindexId(int64_t id);
 
   std::vector<Landmark> landmarks_;
   std::vector<int32_t> free_landmarks_;
@@ -105,6 +111,9 @@ class Map {
   bool live_list_dirty_ = true;
   std::vector<Keyframe> keyframes_;
   std::vector<int> medoid_scratch_;
+  std::vector<int64_t> id_keys_;
+  std::vector<int32_t> id_slots_;  // -1: empty
+  size_t id_mask_ = 0;
   int64_t next_landmark_id_ = 0;
   int64_t next_keyframe_id_ = 0;
 };

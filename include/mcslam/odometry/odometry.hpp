@@ -7,14 +7,10 @@
 #include <memory>
 #include <vector>
 
-#include "mcslam/features/octave_scales.hpp"
-#include "mcslam/backend/sliding_window_solver.hpp"
-#include "mcslam/geometry/absolute_pose_ransac.hpp"
-#include "mcslam/geometry/pose_refinement.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/pose_estimate.hpp"
-#include "mcslam/odometry/projection_search.hpp"
+#include "mcslam/odometry/rig_state.hpp"
 
 namespace mcslam {
 
@@ -50,8 +46,10 @@ struct OdometryTiming {
 class ExtrinsicCheck;
 class Initializer;
 class LocalMapper;
-class ScaleEstimator;
-class ScaleFilter;
+class ScaleSupervisor;
+class TemporalTriangulator;
+class Tracker;
+class WindowBridge;
 
 class Odometry {
  public:
@@ -71,14 +69,15 @@ class Odometry {
   const Map& map() const { return map_; }
   // The rig with the extrinsics the back-end refined (the calibration when refinement is off).
   Rig refinedRig() const;
-  // The rig tracking uses: with refinement on, the extrinsics as of the last applied solve or per-camera check.
-  const Rig& trackingRig() const { return rig_; }
-  // Whether the per-camera check found camera `cam`'s calibration wrong and re-estimated it.
-  bool extrinsicReestimated(int cam) const { return reestimated_[cam] != 0; }
+  // The rig state as of the end of the last frame (tracking takes it at the start of the next one): with
+  // refinement on, the extrinsics as of the last applied solve or per-camera check. A view for the call: a
+  // consumer keeps a copy (RigState::follow()).
+  const RigState& rigState() const;
+  const Rig& trackingRig() const { return rigState().rig(); }
   bool initialized() const { return initialized_; }
   // False while a map started up to scale (rig without overlap) waits for its window to fix the scale: poses
   // until then have an arbitrary unit. True for a metric start and for one camera (whose scale never is).
-  bool scaleConverged() const { return scale_converged_; }
+  bool scaleConverged() const { return rigState().scaleConverged(); }
   // Heap allocations made on the back-end thread so far (0 when the solve runs inline).
   uint64_t backendThreadAllocations() const;
   // Frame index of the reference frame of the last initialization when it used two frames (the frames
@@ -86,62 +85,42 @@ class Odometry {
   int64_t lastInitializationReference() const { return last_init_reference_; }
 
  private:
-  enum class TrackResult { Ok, Failed };
+  // The initialize state: a map from one frame (enough metric multi-view features) or from two.
   void initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
-  TrackResult track(const FrameFeatures& frame, uint64_t frame_index, SE3& T_w_b, int& inliers);
-  // Pose from the current matches (RANSAC or refinement from `guess`); drops the outlier matches and
-  // returns the number of inliers (0 on failure).
-  int poseFromMatches(const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b);
-  bool needKeyframe(const SE3& T_w_b, int inliers, uint64_t frame_index) const;
-  int countKeyframeLandmarks(int slot) const;
+  int initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_index);  // keyframe slot, -1: not yet
+  int initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, bool& metric);
+  // The map starts at keyframe `kf_new`: the track state.
+  void startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out);
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
+  // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.
+  void lose(uint64_t frame_index, int inliers, PoseEstimate& out);
+  // A keyframe of the tracked frame: its landmarks, new points, and its back-end solve started.
+  void makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers,
+                    PoseEstimate& out);
+  // New landmarks across time for keyframe `slot` (TemporalTriangulator); returns how many.
+  int triangulateNew(int slot);
   void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
-  void rememberTracked(const FrameFeatures& frame, uint64_t frame_index);
-  // Estimates the scale of a map started up to scale over its newest keyframes at every keyframe, and
-  // rescales the map when the combined estimate is certain (the first time: the scale has converged) or
-  // significantly off.
+  void clearMap();  // the map, the mapper's pending work and the window
+  // At a settled keyframe of a map started up to scale: the map, the window and the motion model take the unit
+  // the scale supervisor finds.
   void estimateScale();
-  double windowTurn() const;  // largest rotation (rad) of a back-end window keyframe from the window's oldest
-  int searchNewestKeyframeByDescriptor(const FrameFeatures& frame);
-  void useExtrinsic(int cam, const SE3& T_b_c);  // in everything that tracks and maps
 
-  Rig rig_;  // with refinement on, its extrinsics follow the estimates (the back-end keeps the calibration as prior)
   OdometryOptions options_;
-  int capacity_;
   Map map_;
-  ProjectionSearch search_;
-  FrameMatches matches_;
-  AbsolutePoseRansac ransac_;
-  PoseRefiner refiner_;
+  std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<Initializer> initializer_;
   std::unique_ptr<LocalMapper> mapper_;
+  std::unique_ptr<TemporalTriangulator> triangulator_;
+  std::unique_ptr<WindowBridge> bridge_;
   std::unique_ptr<ExtrinsicCheck> extrinsic_check_;  // with refinement on and several cameras
-  std::vector<uint8_t> reestimated_;                 // per camera
-  std::unique_ptr<ScaleEstimator> scale_estimator_;  // null for one camera
-  std::unique_ptr<ScaleFilter> scale_filter_;
-
-  std::vector<PoseObservation> observations_;  // built from matches_
-  std::vector<KeypointRef> observation_refs_;  // which keypoint each observation is
-  std::vector<int32_t> last_tracked_;          // landmark slots tracked in the previous frame
-  int last_tracked_count_ = 0;
-  int last_coarse_inliers_ = 0;  // RANSAC inliers of the previous frame's coarse pose
-  OctaveScales octave_scale_{options_.scale_factor};
+  std::unique_ptr<ScaleSupervisor> scale_;
 
   bool initialized_ = false;
-  bool have_velocity_ = false;
-  SE3 T_w_last_;                  // pose of the previous frame (valid when initialized)
-  SE3 velocity_;                  // T_last_prev^-1 ... relative motion of the last frame step
   SE3 anchor_;                    // pose given to the next initialization (continuity after a loss)
-  uint64_t last_keyframe_frame_ = 0;
-  SE3 last_keyframe_pose_;
-  int last_keyframe_tracked_ = 0;
   int pending_keyframe_ = -1;     // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
   int64_t last_init_reference_ = -1;
-  bool scale_converged_ = true;
-  bool scale_free_start_ = false;  // the map started up to scale: its scale is estimated at keyframes
-  double rotation_travelled_ = 0;  // radians the rig has turned through since the start, frame to frame
   uint64_t frame_index_ = 0;      // of the frame being processed
   OdometryStats stats_;
   OdometryTiming timing_;

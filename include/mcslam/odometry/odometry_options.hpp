@@ -41,18 +41,17 @@ struct OdometryOptions {
   double scale_max_sigma = 0.05 / 3.0;
   double scale_search_ratio = 30.0;
   // ... and when the estimates combined were gathered over at least this much rotation of the rig: the windows
-  // of one turn share their scene and the map's history, and agreed on a unit 5x off in 2 of 7 runs of the
-  // 10 cm rig (one 90-degree corner, BENCHMARKS.md); two corners' worth must confirm it.
+  // of one turn share their scene and the map's history and can agree on a wrong unit; two corners' worth must
+  // confirm it (docs/design/odometry.md).
   double scale_min_rotation_deg = 180.0;
   // Once converged, the map's unit is followed as it drifts: between turns (a straight tells the lever arms
-  // nothing) it is taken to random-walk by this relative sigma per keyframe. Measured on the rendered 10 cm rig:
-  // 4-17% between corners 40-60 keyframes apart (tools/eval/local_scale.py measures it on any recording).
+  // nothing) it is taken to random-walk by this relative sigma per keyframe (tools/eval/local_scale.py measures
+  // the drift on a recording).
   double scale_drift_per_keyframe = 0.01;
   // A map whose unit is held (no overlap) holds it by all the back-end window's keyframes, not by its two oldest
-  // (backend::SolverOptions::hold_window_scale): a pair can be 10 cm apart, and where both side cameras of the
-  // rendered 10 cm rig face blank walls the unit grew 14% in 20 keyframes through it. With it, seven runs: SE(3)
-  // ATE after convergence 0.13 m mean against 0.31, last 120 frames within 5% in 7 of 7 against 6 (BENCHMARKS.md,
-  // "7d"); what it cannot undo is a unit a fast corner's tracking gave the map, which it then keeps.
+  // (backend::SolverOptions::hold_window_scale): two keyframes can be close together, and where the side cameras
+  // see little the unit drifts through that pair. What it cannot undo is a unit a fast corner's tracking gave the
+  // map, which it then keeps.
   bool hold_window_scale = true;
 
   // Mapping.

@@ -9,6 +9,10 @@
 #include "mcslam/odometry/map.hpp"
 
 namespace mcslam {
+class LandmarkTracks;
+}
+
+namespace mcslam {
 
 // Which landmark each keypoint of the current frame is matched to, and back: at most one keypoint per
 // landmark and camera, at most one landmark per keypoint.
@@ -45,23 +49,24 @@ struct ProjectionSearchParams {
 
 class ProjectionSearch {
  public:
+  // Sizes its grids for the rig's images; keeps nothing of the rig.
   ProjectionSearch(const Rig& rig, int max_features_per_camera);
 
   // Buckets the frame's keypoints for radius search. Call once per frame.
   void prepare(const FrameFeatures& frame);
 
-  // Projects the landmarks `slots[0..n)` with the body pose T_w_b into every camera and matches each to
+  // Projects the landmarks `slots[0..n)` with the body pose T_w_b into every camera of `rig` (a view for the call:
+  // the caller's current extrinsics) and matches each to
   // the best keypoint near its projection. Landmarks already matched in a camera are not searched
-  // there again. With `count_visible`, landmarks predicted inside an image get visible++.
-  int search(Map& map, const int32_t* slots, int n, const SE3& T_w_b, const FrameFeatures& frame,
-             const ProjectionSearchParams& params, FrameMatches& matches, bool count_visible);
+  // there again. With `count_visible` (the tracker's counts), landmarks predicted inside an image get visible++.
+  int search(const Map& map, const Rig& rig, const int32_t* slots, int n, const SE3& T_w_b, const FrameFeatures& frame,
+             const ProjectionSearchParams& params, FrameMatches& matches, LandmarkTracks* count_visible);
 
   // Matches landmarks to keypoints of any camera by descriptor alone (no geometry): for recovery.
   int searchByDescriptor(const Map& map, const int32_t* slots, int n, const FrameFeatures& frame, int max_hamming,
                          float ratio, FrameMatches& matches);
 
  private:
-  const Rig& rig_;
   std::vector<KeypointGrid> grids_;
   std::vector<SE3> T_c_w_;
   // Per camera: cosine of the widest angle from the optical axis that any pixel of the image sees, with a

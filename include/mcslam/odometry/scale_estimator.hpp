@@ -26,6 +26,7 @@
 
 #include "mcslam/backend/robust_loss.hpp"
 #include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/rig_state.hpp"
 
 namespace mcslam {
 
@@ -49,6 +50,8 @@ class ScaleEstimator {
   // max_keyframes: the map's keyframe capacity. All scratch is allocated here: estimate() allocates nothing.
   ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
                  float octave_scale_factor, int levels);
+  // Takes the current extrinsics by value (estimate() uses them); allocates nothing.
+  void follow(const RigState& state) { rig_ = state.rig(); }
 
   // Uses the map's newest live keyframes (up to kMaxKeyframes) and the landmarks that kMinLandmarkKeyframes of
   // them observe. `max_ratio` bounds the coarse search: s in [1 / max_ratio, max_ratio]; at most 1, the
@@ -85,7 +88,7 @@ class ScaleEstimator {
   // Block of window keyframe w in the reduced pose system (-1: the oldest, held).
   int freeIndex(int w) const { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); }
 
-  const Rig& rig_;
+  Rig rig_;  // a copy: follow() moves its extrinsics
   backend::RobustLoss loss_;
   std::vector<double> octave_sigma_;
   std::vector<SE3> T_c_b_;     // per camera, from the rig at the start of estimate() (its extrinsics may follow
@@ -112,9 +115,8 @@ class ScaleEstimator {
 // independent, and of two that overlap in a turn the later usually holds more of it (its sigma falls from tens
 // of percent to a few as the turn enters the window): of overlapping windows only the most certain counts
 // (pending); it is fused with the earlier ones (committed) once a window sharing no keyframe with it arrives.
-// (Counting every window by its share of new keyframes instead kept the windows before a turn, which saw
-// little of it, at the weight of the turn's own: the combination crept 1.00 -> 1.05 while a turn's windows
-// said 1.16 +- 2.5%, rendered 10 cm rig.) An estimate that disagrees with the combined one by more than 3 sigma
+// (Counting every window by its share of new keyframes instead would keep the windows before a turn, which saw
+// little of it, at the weight of the turn's own.) An estimate that disagrees with the combined one by more than 3 sigma
 // is dropped; when several in a row disagree, the map's scale has drifted (a straight stretch hides it) and the
 // combination restarts from the latest. Windows of one turn also share their scene and the map's history:
 // rotationSpan() says over how much rotation of the rig (radians travelled, `rotation` of add()) the combined

@@ -1,6 +1,5 @@
 #pragma once
 // The whole SLAM pipeline behind the FrameProcessor boundary: front-end, odometry and back-end.
-#include <array>
 #include <vector>
 
 #include "mcslam/odometry/odometry.hpp"
@@ -77,9 +76,10 @@ class SlamPipeline final : public FrameProcessor {
   // check found wrong (its 2 px epipolar gate would keep rejecting that camera; for the others the calibration
   // is within the gate and stays). The front-end of the n-th frame uses the estimates as of the end of tracking
   // frame n-2, whether it runs before tracking frame n-1 ends (stages, --overlap) or after (process()): the same
-  // features either way. One slot per parity: a writer never meets its reader.
+  // features either way. One slot per parity, each the odometry's rig state by value: a writer never meets its
+  // reader.
   bool handover_ = false;
-  std::array<std::vector<SE3>, 2> extrinsics_after_;
+  std::vector<RigState> rig_after_;  // two slots when handover_
   uint64_t features_computed_ = 0;  // touched by the front-end's thread only
   uint64_t frames_tracked_ = 0;     // by the tracking thread only
 };

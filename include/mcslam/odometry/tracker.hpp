@@ -1,0 +1,98 @@
+#pragma once
+// Tracking (paper IV-C): the pose of every frame against the local map, from the motion model's prediction
+// through projection search, RANSAC and refinement, with a descriptor-only fallback; the keyframe decision. It
+// owns the motion model, the list of landmarks tracked in the last frame and what it counts per landmark
+// (LandmarkTracks); it reads the map (a view for each call) and never writes it. It follows the rig state by
+// value at frame boundaries. All memory is allocated at construction.
+#include <cstdint>
+#include <vector>
+
+#include "mcslam/features/octave_scales.hpp"
+#include "mcslam/geometry/absolute_pose_ransac.hpp"
+#include "mcslam/geometry/pose_refinement.hpp"
+#include "mcslam/odometry/landmark_tracks.hpp"
+#include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/odometry_options.hpp"
+#include "mcslam/odometry/projection_search.hpp"
+#include "mcslam/odometry/rig_state.hpp"
+
+namespace mcslam {
+
+class Tracker {
+ public:
+  Tracker(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
+
+  // Takes the rig state by value when it changed (at the start of a frame).
+  void follow(const RigState& state);
+
+  // Pose of `frame` against `map` (its live list refreshed). False when lost; `inliers` then says how many the
+  // best attempt had. On success the matches (matches()) are the inliers of the pose.
+  bool track(const Map& map, const FrameFeatures& frame, uint64_t frame_index, SE3& T_w_b, int& inliers);
+  // The frame was tracked at T_w_b: the motion model moves on.
+  void advance(const SE3& T_w_b);
+  // The frame was lost: the motion model carries the pose on (returned).
+  const SE3& coast();
+  bool needKeyframe(const Map& map, const SE3& T_w_b, int inliers, uint64_t frame_index) const;
+  // A keyframe was made of frame `frame_index` at T_w_b.
+  void keyframeMade(uint64_t frame_index, const SE3& T_w_b) {
+    last_keyframe_frame_ = frame_index;
+    last_keyframe_pose_ = T_w_b;
+  }
+  // Keyframe `slot` is final (optimized, culled): the next frames continue from its pose, with the same velocity,
+  // and landmarks the back-end or the culling erased are no longer tracked.
+  void keyframeSettled(const Map& map, int slot);
+  // The landmarks matched in this frame become the first attempt's list for the next one.
+  void rememberTracked(const Map& map, const FrameFeatures& frame, uint64_t frame_index);
+  // A new map starts at its keyframe `slot` (of frame `frame_index`): tracking continues from its pose and
+  // landmarks, without velocity.
+  void startFrom(const Map& map, int slot, uint64_t frame_index);
+  // The map was dropped: nothing tracked, no velocity (the pose stays).
+  void reset();
+  // The map took a new unit: positions about `center` times s.
+  void rescale(double s, const Vec3& center);
+
+  const SE3& pose() const { return T_w_last_; }  // of the last frame
+  // Share of the last keyframe's landmarks that `inliers` is, up to 1.
+  float quality(int inliers) const;
+  double rotationTravelled() const { return rotation_travelled_; }  // radians, frame to frame, since the start
+  uint64_t recoveries() const { return recoveries_; }  // frames tracked only through the descriptor fallback
+  const LandmarkTracks& landmarkTracks() const { return tracks_; }
+  // The search and the inlier matches of the last tracked frame (the per-camera extrinsic check reuses them).
+  ProjectionSearch& search() { return search_; }
+  const FrameMatches& matches() const { return matches_; }
+
+ private:
+  // Coarse pose in up to three attempts (see track()); the attempt with the most inliers gives it.
+  bool coarsePose(const Map& map, const FrameFeatures& frame, uint64_t frame_index, const SE3& predicted,
+                  ProjectionSearchParams& params, SE3& coarse, int& inliers);
+  // Pose from the current matches (RANSAC or refinement from `guess`); drops the outlier matches and
+  // returns the number of inliers (0 on failure).
+  int poseFromMatches(const Map& map, const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b);
+  int searchNewestKeyframeByDescriptor(const Map& map, const FrameFeatures& frame);
+  int countKeyframeLandmarks(const Map& map, int slot) const;
+
+  RigState rig_;  // a copy of the odometry's, taken at frame boundaries
+  OdometryOptions options_;
+  ProjectionSearch search_;
+  FrameMatches matches_;
+  AbsolutePoseRansac ransac_;
+  PoseRefiner refiner_;
+  LandmarkTracks tracks_;
+  std::vector<PoseObservation> observations_;  // built from matches_
+  std::vector<KeypointRef> observation_refs_;  // which keypoint each observation is
+  std::vector<int32_t> last_tracked_;          // landmark slots tracked in the previous frame
+  int last_tracked_count_ = 0;
+  int last_coarse_inliers_ = 0;  // RANSAC inliers of the previous frame's coarse pose
+  OctaveScales octave_scale_{options_.scale_factor};
+
+  bool have_velocity_ = false;
+  SE3 T_w_last_;                  // pose of the previous frame
+  SE3 velocity_;                  // relative motion of the last frame step
+  uint64_t last_keyframe_frame_ = 0;
+  SE3 last_keyframe_pose_;
+  int last_keyframe_tracked_ = 0;
+  double rotation_travelled_ = 0;
+  uint64_t recoveries_ = 0;
+};
+
+}  // namespace mcslam

@@ -1,0 +1,105 @@
+#include "mcslam/odometry/scale_supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+#include "mcslam/odometry/odometry.hpp"
+#include "mcslam/odometry/scale_estimator.hpp"
+
+namespace mcslam {
+
+namespace {
+
+// The lever arms tell the scale only while the window turns: a window that turned less than this is not searched
+// (its estimate would come back with a useless sigma after costing the tracking thread most of a frame, at every
+// keyframe of a rig whose scale never converges).
+constexpr double kMinWindowTurnRad = 2.0 * M_PI / 180.0;
+// The search range: the whole of OdometryOptions::scale_search_ratio while the unit is arbitrary; within a factor
+// kKnownRatio once the combined windows know it to kKnownSigma or it has converged (the search re-fits the window
+// at every factor it tries: the range is most of its cost).
+constexpr double kKnownSigma = 0.2, kKnownRatio = 2.0;
+
+}  // namespace
+
+ScaleSupervisor::ScaleSupervisor(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
+    : options_(options) {
+  const int cams = rig.size();
+  if (cams < 2) return;
+  const int scale_keyframes = std::min(options.max_keyframes, ScaleEstimator::kMaxKeyframes);
+  const int window_obs = scale_keyframes * cams * max_features_per_camera;
+  estimator_ = std::make_unique<ScaleEstimator>(rig, std::min(options.max_landmarks, window_obs), window_obs,
+                                                options.max_keyframes, options.scale_factor, options.levels);
+  filter_ = std::make_unique<ScaleFilter>();
+}
+
+ScaleSupervisor::~ScaleSupervisor() = default;
+
+void ScaleSupervisor::start(bool unscaled) {
+  unscaled_start_ = unscaled;
+  if (filter_) filter_->reset();
+}
+
+double ScaleSupervisor::windowTurn(const Map& map) {
+  const int oldest = map.oldestWindowKeyframe();
+  double turn = 0;
+  for (int i = 0; oldest >= 0 && i < map.keyframeCapacity(); ++i) {
+    const Keyframe& k = map.keyframe(i);
+    if (!k.alive || !k.in_backend) continue;
+    turn = std::max(turn, rotationAngle(map.keyframe(oldest).T_w_b.R, k.T_w_b.R));
+  }
+  return turn;
+}
+
+ScaleSupervisor::Rescale ScaleSupervisor::onKeyframe(const Map& map, const RigState& rig, double rotation_travelled,
+                                                     uint64_t frame_index, OdometryStats& stats) {
+  Rescale r;
+  // At every keyframe, before convergence and after it: the unit drifts between turns, and the profile search
+  // finds what a refinement from the map as it is would not (the map's own unit looks best to it).
+  if (!unscaled_start_ || !estimator_) return r;
+  if (windowTurn(map) < kMinWindowTurnRad) return r;
+  const bool scale_converged = rig.scaleConverged();
+  const double ratio = scale_converged || filter_->sigma() <= kKnownSigma
+                           ? std::min(kKnownRatio, options_.scale_search_ratio)
+                           : options_.scale_search_ratio;
+  estimator_->follow(rig);
+  const ScaleEstimate e = estimator_->estimate(map, ratio);
+  ++stats.scale_estimates;
+  if (!e.ok) return r;
+  stats.last_scale = e.scale;
+  stats.last_scale_sigma = e.relative_sigma;
+  if (!filter_->add(std::log(e.scale), e.relative_sigma, e.oldest_id, e.newest_id, rotation_travelled)) {
+    spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} dropped as an outlier", frame_index, e.scale,
+                  e.relative_sigma);
+    return r;
+  }
+  const double x = filter_->correction(), sigma = filter_->sigma();
+  stats.combined_scale_sigma = sigma;
+  // One line per estimate, for studies against ground truth (mcslam-run --log-level debug).
+  spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks, chi2/dof "
+                "{:.2f}), combined {:.4f} sigma {:.4f} over {:.0f} deg", frame_index, e.scale, e.relative_sigma,
+                e.keyframes, e.landmarks, e.reduced_chi2, std::exp(x), sigma, filter_->rotationSpan() * 180.0 / M_PI);
+  // A correction 3 sigma away from 1 is applied at any time: before convergence it brings the arbitrary unit near
+  // the metric one (the windows' fits then start in the basin; far off, most windows give no estimate), the poses
+  // staying flagged unscaled until the combined sigma reaches the bound.
+  const bool converges = !scale_converged && sigma <= options_.scale_max_sigma &&
+                         filter_->rotationSpan() >= options_.scale_min_rotation_deg * M_PI / 180.0;
+  // Once converged the map follows the combined estimate as the unit drifts, whenever it is 2 sigma off.
+  const double significant = scale_converged ? 2.0 : 3.0;
+  if (!converges && !(std::abs(x) > significant * sigma)) return r;
+  r.apply = true;
+  r.s = std::exp(x);
+  r.center = e.center;
+  r.converged = converges;
+  spdlog::debug("odometry: map rescaled by {:.4f} at frame {}", r.s, frame_index);
+  filter_->applied();
+  ++stats.scale_rescales;
+  if (converges) {
+    filter_->setDrift(options_.scale_drift_per_keyframe);
+    stats.scale_converged_frame = static_cast<int64_t>(frame_index);
+  }
+  return r;
+}
+
+}  // namespace mcslam

@@ -1,0 +1,288 @@
+#include "mcslam/odometry/tracker.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+namespace mcslam {
+
+namespace {
+
+AbsolutePoseRansacOptions ransacOptions(const OdometryOptions& o) {
+  AbsolutePoseRansacOptions r;
+  r.min_inliers = o.min_tracked;
+  r.max_iterations = 300;
+  return r;
+}
+
+PoseRefinementOptions refinementOptions(const OdometryOptions& o) {
+  PoseRefinementOptions r;
+  r.min_inliers = o.min_tracked;
+  return r;
+}
+
+}  // namespace
+
+Tracker::Tracker(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
+    : rig_(rig),
+      options_(options),
+      search_(rig, max_features_per_camera),
+      ransac_(rig, rig.size() * max_features_per_camera, ransacOptions(options)),
+      refiner_(rig, rig.size() * max_features_per_camera, refinementOptions(options)),
+      tracks_(options.max_landmarks) {
+  matches_.allocate(rig.size(), max_features_per_camera, options.max_landmarks);
+  observations_.resize(static_cast<std::size_t>(rig.size()) * max_features_per_camera);
+  observation_refs_.resize(observations_.size());
+  last_tracked_.resize(options.max_landmarks);
+}
+
+void Tracker::follow(const RigState& state) {
+  if (!rig_.follow(state)) return;
+  for (int c = 0; c < rig_.cameras(); ++c) {
+    ransac_.setExtrinsic(c, rig_.T_b_c(c));
+    refiner_.setExtrinsic(c, rig_.T_b_c(c));
+  }
+}
+
+bool Tracker::track(const Map& map, const FrameFeatures& frame, uint64_t frame_index, SE3& T_w_b, int& inliers) {
+  const SE3 predicted = have_velocity_ ? T_w_last_ * velocity_ : T_w_last_;
+  search_.prepare(frame);
+  ProjectionSearchParams params;
+  params.max_hamming = options_.max_hamming;
+  params.ratio = options_.ratio;
+  params.scale_factor = options_.scale_factor;
+  params.levels = options_.levels;
+  SE3 coarse;
+  if (!coarsePose(map, frame, frame_index, predicted, params, coarse, inliers)) return false;
+
+  // The local map, projected with the coarse pose into every camera, then the final refinement.
+  params.radius_px = options_.local_map_radius_px;
+  search_.search(map, rig_.rig(), map.liveLandmarkSlots(), map.liveLandmarkCount(), coarse, frame, params, matches_,
+                 &tracks_);
+  const int refined = poseFromMatches(map, frame, coarse, false, T_w_b);
+  if (refined >= options_.min_tracked) {
+    inliers = refined;
+  } else {
+    T_w_b = coarse;
+  }
+  // Landmarks found in this frame.
+  for (int c = 0; c < frame.cameras(); ++c) {
+    for (int k = 0; k < frame.sets[c].count; ++k) {
+      const int lm = matches_.landmarkOf(c, k);
+      if (lm < 0) continue;
+      LandmarkTrack& t = tracks_.of(map, lm);
+      if (t.matched_frame != frame_index) {
+        t.matched_frame = frame_index;
+        ++t.found;
+      }
+    }
+  }
+  return true;
+}
+
+bool Tracker::coarsePose(const Map& map, const FrameFeatures& frame, uint64_t frame_index, const SE3& predicted,
+                         ProjectionSearchParams& params, SE3& coarse, int& inliers) {
+  // Up to three attempts of growing cost, until one is strong (a fair share of the previous frame's inliers; a
+  // weak consensus is often a wrong pose after a jolt the motion model did not predict):
+  //   0. the landmarks tracked in the previous frame, around the motion-model prediction;
+  //   1. the whole local map with a wide radius (sudden turns, stops);
+  //   2. recovery: the newest keyframe's landmarks matched by descriptor alone, any camera, no geometry.
+  const auto strong = [&](int n) {
+    return n >= options_.min_tracked && n >= options_.strong_tracking_share * last_coarse_inliers_;
+  };
+  coarse = predicted;
+  int best_attempt = -1, last_attempt = -1;
+  inliers = 0;
+  for (int attempt = 0; attempt < 3 && !strong(inliers); ++attempt) {
+    matches_.reset(frame);
+    last_attempt = attempt;
+    int found = 0;
+    if (attempt < 2) {
+      params.radius_px = options_.track_radius_px * (attempt == 0 ? 1.0 : options_.wide_radius_factor);
+      const int32_t* slots = attempt == 0 ? last_tracked_.data() : map.liveLandmarkSlots();
+      const int n = attempt == 0 ? last_tracked_count_ : map.liveLandmarkCount();
+      found = search_.search(map, rig_.rig(), slots, n, predicted, frame, params, matches_, nullptr);
+    } else {
+      found = searchNewestKeyframeByDescriptor(map, frame);
+    }
+    SE3 candidate = predicted;
+    const int n = found >= options_.min_matches_for_pose ? poseFromMatches(map, frame, predicted, true, candidate) : 0;
+    spdlog::trace("odometry: frame {}: coarse attempt {}: {} matches, {} inliers", frame_index, attempt, found, n);
+    if (n > inliers) {
+      inliers = n;
+      coarse = candidate;
+      best_attempt = attempt;
+    }
+  }
+  if (inliers < options_.min_tracked) return false;
+  if (best_attempt == 2) ++recoveries_;
+  last_coarse_inliers_ = inliers;
+  if (best_attempt != last_attempt) {
+    // A later attempt replaced the best one's matches: find them again around the coarse pose.
+    matches_.reset(frame);
+    params.radius_px = options_.track_radius_px;
+    search_.search(map, rig_.rig(), map.liveLandmarkSlots(), map.liveLandmarkCount(), coarse, frame, params, matches_,
+                   nullptr);
+  }
+  return true;
+}
+
+int Tracker::searchNewestKeyframeByDescriptor(const Map& map, const FrameFeatures& frame) {
+  const int newest = map.newestKeyframe();
+  int n = 0;
+  if (newest >= 0) {
+    const Keyframe& kf = map.keyframe(newest);
+    for (int c = 0; c < kf.features.cameras(); ++c) {
+      for (int k = 0; k < kf.features.sets[c].count; ++k) {
+        if (kf.landmark_of[c][k] >= 0) last_tracked_[n++] = kf.landmark_of[c][k];
+      }
+    }
+  }
+  last_tracked_count_ = 0;  // the list now holds keyframe landmarks, possibly repeated: not reusable
+  return search_.searchByDescriptor(map, last_tracked_.data(), n, frame, options_.max_hamming, 0.8f, matches_);
+}
+
+int Tracker::poseFromMatches(const Map& map, const FrameFeatures& frame, const SE3& guess, bool use_ransac,
+                             SE3& T_w_b) {
+  int n = 0;
+  for (int c = 0; c < frame.cameras(); ++c) {
+    for (int k = 0; k < frame.sets[c].count; ++k) {
+      const int lm = matches_.landmarkOf(c, k);
+      if (lm < 0 || !frame.valid[c][k]) continue;
+      const Keypoint& kp = frame.sets[c].keypoints[k];
+      PoseObservation& o = observations_[n];
+      o.camera = c;
+      o.pixel = Vec2(kp.x, kp.y);
+      o.ray = bodyRay(rig_.rig(), c, frame.bearings[c][k]);
+      o.point_w = map.landmark(lm).p_w;
+      o.sigma_px = octave_scale_[kp.octave];
+      observation_refs_[n] = KeypointRef{static_cast<int16_t>(c), k};
+      ++n;
+    }
+  }
+  if (n < options_.min_matches_for_pose) return 0;
+  const std::span<const PoseObservation> obs(observations_.data(), n);
+  std::span<const uint8_t> mask;
+  int inliers = 0;
+  if (use_ransac) {
+    const AbsolutePoseRansacResult r = ransac_.estimate(obs, &guess);
+    if (!r.ok()) return 0;
+    T_w_b = r.T_w_b;
+    mask = r.inlier_mask;
+    inliers = r.num_inliers;
+  } else {
+    const PoseRefinementResult r = refiner_.refine(obs, guess);
+    if (!r.success) return 0;
+    T_w_b = r.T_w_b;
+    mask = r.inlier_mask;
+    inliers = r.num_inliers;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!mask[i]) matches_.clear(observation_refs_[i].cam, observation_refs_[i].index);
+  }
+  return inliers;
+}
+
+void Tracker::advance(const SE3& T_w_b) {
+  velocity_ = T_w_last_.inverse() * T_w_b;
+  have_velocity_ = true;
+  rotation_travelled_ += rotationAngle(T_w_last_.R, T_w_b.R);
+  T_w_last_ = T_w_b;
+}
+
+const SE3& Tracker::coast() {
+  // The trajectory stays continuous through a loss.
+  T_w_last_ = have_velocity_ ? T_w_last_ * velocity_ : T_w_last_;
+  return T_w_last_;
+}
+
+bool Tracker::needKeyframe(const Map& map, const SE3& T_w_b, int inliers, uint64_t frame_index) const {
+  if (frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval)) return true;
+  if (inliers < options_.keyframe_tracked_ratio * last_keyframe_tracked_) return true;
+  const SE3 motion = last_keyframe_pose_.inverse() * T_w_b;
+  if (so3Log(motion.R).norm() * 180.0 / M_PI > options_.keyframe_rotation_deg) return true;
+  // Translation against the typical depth of what is tracked.
+  double depth_sum = 0;
+  int depth_n = 0;
+  for (int i = 0; i < last_tracked_count_ && depth_n < 200; ++i) {
+    depth_sum += (map.landmark(last_tracked_[i]).p_w - T_w_b.t).norm();
+    ++depth_n;
+  }
+  const double depth = depth_n ? depth_sum / depth_n : 1.0;
+  return motion.t.norm() > options_.keyframe_translation_ratio * depth;
+}
+
+int Tracker::countKeyframeLandmarks(const Map& map, int slot) const {
+  const Keyframe& kf = map.keyframe(slot);
+  int n = 0;
+  for (int c = 0; c < kf.features.cameras(); ++c) {
+    for (int k = 0; k < kf.features.sets[c].count; ++k) n += kf.landmark_of[c][k] >= 0 ? 1 : 0;
+  }
+  return n;
+}
+
+void Tracker::keyframeSettled(const Map& map, int slot) {
+  T_w_last_ = map.keyframe(slot).T_w_b;
+  last_keyframe_pose_ = T_w_last_;
+  last_keyframe_tracked_ = countKeyframeLandmarks(map, slot);
+  int kept = 0;
+  for (int i = 0; i < last_tracked_count_; ++i) {
+    if (map.landmark(last_tracked_[i]).alive) last_tracked_[kept++] = last_tracked_[i];
+  }
+  last_tracked_count_ = kept;
+}
+
+void Tracker::rememberTracked(const Map& map, const FrameFeatures& frame, uint64_t frame_index) {
+  last_tracked_count_ = 0;
+  for (int c = 0; c < frame.cameras(); ++c) {
+    for (int k = 0; k < frame.sets[c].count; ++k) {
+      const int lm = matches_.landmarkOf(c, k);
+      if (lm < 0 || !map.landmark(lm).alive) continue;
+      LandmarkTrack& t = tracks_.of(map, lm);
+      if (t.listed_frame == frame_index) continue;  // a landmark seen by several cameras: once
+      t.listed_frame = frame_index;
+      last_tracked_[last_tracked_count_++] = lm;
+    }
+  }
+}
+
+void Tracker::startFrom(const Map& map, int slot, uint64_t frame_index) {
+  T_w_last_ = map.keyframe(slot).T_w_b;
+  have_velocity_ = false;
+  last_keyframe_frame_ = frame_index;
+  last_keyframe_pose_ = T_w_last_;
+  last_keyframe_tracked_ = countKeyframeLandmarks(map, slot);
+  last_tracked_count_ = 0;
+  last_coarse_inliers_ = 0;
+  const Keyframe& kf = map.keyframe(slot);
+  for (int c = 0; c < kf.features.cameras(); ++c) {
+    for (int k = 0; k < kf.features.sets[c].count; ++k) {
+      const int lm = kf.landmark_of[c][k];
+      if (lm < 0) continue;
+      LandmarkTrack& t = tracks_.of(map, lm);
+      if (t.matched_frame != frame_index) {
+        t.matched_frame = frame_index;
+        last_tracked_[last_tracked_count_++] = lm;
+      }
+    }
+  }
+}
+
+void Tracker::reset() {
+  last_tracked_count_ = 0;
+  last_coarse_inliers_ = 0;
+  have_velocity_ = false;
+}
+
+void Tracker::rescale(double s, const Vec3& center) {
+  T_w_last_.t = center + s * (T_w_last_.t - center);
+  last_keyframe_pose_.t = center + s * (last_keyframe_pose_.t - center);
+  velocity_.t *= s;
+}
+
+float Tracker::quality(int inliers) const {
+  return static_cast<float>(std::min(1.0, inliers / std::max(1.0, 0.5 * last_keyframe_tracked_)));
+}
+
+}  // namespace mcslam
