@@ -6,6 +6,7 @@
 #include <bit>
 #include <limits>
 
+#include "mcslam/backend/levenberg_marquardt.hpp"
 #include "mcslam/backend/reprojection_residual.hpp"
 
 namespace mcslam {
@@ -15,8 +16,6 @@ namespace {
 // that the cost stays continuous enough to search.
 constexpr double kMissingSigmas = 10.0;
 constexpr int kRefineSteps = 6;
-// Levenberg-Marquardt damping (relative to the system's diagonal): a step that does not lower the cost is
-// retried with ten times more, up to the largest (then the window is at its minimum).
 constexpr double kMinDamping = 1e-6, kMaxDamping = 1e4;
 // The profile's spacing in s, and the steps that re-fit the window at each factor (from its neighbour's fit): the
 // profile only chooses the basin, the free refinement then finds the minimum in it.
@@ -26,7 +25,7 @@ constexpr int kProfileSteps = 2;
 
 ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
                                float octave_scale_factor, int levels)
-    : rig_(rig) {
+    : rig_(rig), schur_(kMaxKeyframes, kMaxLandmarkObservations) {
   kf_slot_of_.resize(max_keyframes);
   kf_order_.resize(max_keyframes);
   for (int o = 0; o < std::max(levels, 1); ++o) octave_sigma_.push_back(std::pow(octave_scale_factor, o));
@@ -107,37 +106,55 @@ void ScaleEstimator::restoreWindow(const std::vector<SE3>& kf, const std::vector
   std::copy_n(lm.begin(), nl_, lm_p_.begin());
 }
 
-bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
-  c = cost();
-  u_step = 0;
-  double lambda = kMinDamping;
-  ReducedVec step;
-  for (int it = 0; it < steps; ++it) {
+// Levenberg-Marquardt over the free keyframe poses; the landmarks follow (re-fitted in every cost and system).
+class ScaleEstimator::Problem final : public backend::LeastSquaresProblem {
+ public:
+  explicit Problem(ScaleEstimator& e) : e_(e), c_(e.cost()) {}
+  bool linearize() override {
     double chi2 = 0;
     int residuals = 0;
-    if (!reducedSystem(chi2, residuals)) return false;
-    std::copy_n(kf_T_.begin(), nk_, kf_before_.begin());
-    bool taken = false;
-    for (; !taken && lambda <= kMaxDamping; lambda *= 10.0) {
-      if (!dampedStep(lambda, step)) continue;
-      for (int w = 0; w < nk_; ++w) {
-        const int f = freeIndex(w);
-        if (f >= 0) kf_T_[w] = kf_before_[w] * SE3::exp(step.segment<6>(6 * f));
-      }
-      const double trial = cost();
-      if (trial < c) {
-        c = trial;
-        u_step = g_.dot(step);
-        taken = true;
-      }
-    }
-    if (!taken) {  // no descent even along the gradient: the minimum
-      std::copy_n(kf_before_.begin(), nk_, kf_T_.begin());
-      break;
-    }
-    lambda = std::max(kMinDamping, lambda / 100.0);  // the loop's last *10 included
+    if (!e_.reducedSystem(chi2, residuals)) return false;
+    std::copy_n(e_.kf_T_.begin(), e_.nk_, e_.kf_before_.begin());
+    return true;
   }
-  return true;
+  double cost() const override { return c_; }
+  void buildDampedSystem(double lambda) override { lambda_ = lambda; }
+  bool solveStep() override { return e_.dampedStep(lambda_, step_); }
+  double stepNorm() const override { return step_.norm(); }
+  double modelCostDecrease(double) const override { return -(e_.b_.dot(step_) + 0.5 * step_.dot(e_.S_ * step_)); }
+  bool evaluateTrial(double& cost) override {
+    for (int w = 0; w < e_.nk_; ++w) {
+      const int f = e_.freeIndex(w);
+      if (f >= 0) e_.kf_T_[w] = e_.kf_before_[w] * SE3::exp(step_.segment<6>(6 * f));
+    }
+    cost = trial_ = e_.cost();
+    return true;
+  }
+  void acceptTrial() override {
+    c_ = trial_;
+    u_step_ = e_.g_.dot(step_);
+  }
+  void rejectTrial() override { std::copy_n(e_.kf_before_.begin(), e_.nk_, e_.kf_T_.begin()); }
+  double uStep() const { return u_step_; }
+
+ private:
+  ScaleEstimator& e_;
+  double c_, trial_ = 0, lambda_ = 0, u_step_ = 0;
+  ReducedVec step_;
+};
+
+bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
+  // Marquardt's lambda relative to the diagonal: a step that does not lower the cost is retried with ten times
+  // more, up to the largest (then the window is at its minimum); after a step, a tenth of the lambda taken.
+  backend::LoopOptions loop;
+  loop.damping = backend::DampingPolicy::multiplicative(kMinDamping, 10.0, 10.0, kMinDamping, kMaxDamping);
+  loop.damping.accept_divisor = 100.0;
+  loop.max_steps = steps;
+  Problem problem(*this);
+  const backend::LoopSummary summary = backend::minimize(problem, loop);
+  c = problem.cost();
+  u_step = problem.uStep();
+  return !summary.failed;
 }
 
 double ScaleEstimator::scaleOfPoses() const {
@@ -152,8 +169,6 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
   b_.setZero(dim);
   chi2 = 0;
   residuals = 0;
-  Eigen::Matrix<double, 6, 3> W[kMaxLandmarkObservations];
-  int wf[kMaxLandmarkObservations];
   SE3 T_b_w[kMaxKeyframes];
   for (int w = 0; w < nk_; ++w) T_b_w[w] = kf_T_[w].inverse();
   for (int l = 0; l < nl_; ++l) {
@@ -162,7 +177,7 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
     lm_p_[l] = p;
     Mat3 Hll = Mat3::Zero();
     Vec3 bl = Vec3::Zero();
-    int m = 0;
+    schur_.beginPoint();
     for (int i = lm_first_[l]; i < lm_first_[l + 1]; ++i) {
       const Obs& o = obs_[i];
       Vec2 r;
@@ -178,20 +193,15 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
       Hll.noalias() += wt * J.point.transpose() * J.point;
       bl.noalias() += wt * J.point.transpose() * r;
       const int f = freeIndex(o.kf);
-      if (f < 0 || m >= kMaxLandmarkObservations) continue;
+      if (f < 0 || schur_.full()) continue;
       S_.block<6, 6>(6 * f, 6 * f).noalias() += wt * J.pose.transpose() * J.pose;
       b_.segment<6>(6 * f).noalias() += wt * J.pose.transpose() * r;
-      W[m] = wt * J.pose.transpose() * J.point;
-      wf[m++] = f;
+      schur_.appendCoupling(f) = wt * J.pose.transpose() * J.point;
     }
     Hll.diagonal().array() += 1e-9;
     const Mat3 Hinv = Hll.inverse();
     if (!Hinv.allFinite()) continue;
-    for (int a = 0; a < m; ++a) {
-      const Eigen::Matrix<double, 6, 3> WH = W[a] * Hinv;
-      b_.segment<6>(6 * wf[a]).noalias() -= WH * bl;
-      for (int c = 0; c < m; ++c) S_.block<6, 6>(6 * wf[a], 6 * wf[c]).noalias() -= WH * W[c].transpose();
-    }
+    schur_.eliminate(Hinv, bl, S_, b_);
   }
   // Scale gradient: u = log(sum of |t_i - t_oldest|), right perturbation moves t_i by R_i rho.
   const double sum = scaleOfPoses();

@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 
 #include "mcslam/backend/robust_loss.hpp"
+#include "mcslam/backend/schur_accumulator.hpp"
 #include "mcslam/odometry/map.hpp"
 
 namespace mcslam {
@@ -67,6 +68,7 @@ class ScaleEstimator {
     Vec2 uv;
     double inv_sigma;
   };
+  class Problem;  // the Levenberg-Marquardt problem of refine()
   double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
   // Robust cost of landmark l at p, keyframes at kf_T_; p is refined first (two Gauss-Newton steps).
   double landmarkCost(int l, Vec3& p);
@@ -95,6 +97,7 @@ class ScaleEstimator {
   std::vector<SE3> kf_start_, kf_best_;  // the window as the map has it, and the profile's best fit
   std::vector<Vec3> lm_start_, lm_best_;
   int oldest_ = 0;              // window index of the oldest keyframe (held)
+  backend::SchurAccumulator schur_;  // eliminates the landmarks from the reduced pose system
   Reduced S_, damped_;
   ReducedVec b_, g_;
   double scale_variance_ = 0;  // g^T S^-1 g of the last reduced system
