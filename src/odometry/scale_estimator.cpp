@@ -235,12 +235,12 @@ bool ScaleEstimator::dampedStep(double lambda, ReducedVec& step) {
   return step.allFinite();
 }
 
-ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
-  ScaleEstimate out;
+// The window: the map's newest live keyframes (up to kMaxKeyframes), the back-end's and the older ones kept for
+// tracking: a window that spans a whole turn sees the lever arms move most. The oldest is the centre, held.
+// False when there are too few (or the map is not the one the estimator was sized for).
+bool ScaleEstimator::selectWindow(const Map& map, ScaleEstimate& out) {
   for (int c = 0; c < rig_.size(); ++c) T_c_b_[c] = rig_.T_b_c(c).inverse();
-  // The window: the map's newest live keyframes (up to kMaxKeyframes), the back-end's and the older ones kept for
-  // tracking: a window that spans a whole turn sees the lever arms move most. The oldest is the centre, held.
-  if (map.keyframeCapacity() > static_cast<int>(kf_slot_of_.size())) return out;  // not the map it was sized for
+  if (map.keyframeCapacity() > static_cast<int>(kf_slot_of_.size())) return false;  // not the map it was sized for
   std::fill(kf_slot_of_.begin(), kf_slot_of_.end(), -1);
   int live = 0;
   for (int i = 0; i < map.keyframeCapacity(); ++i) {
@@ -248,7 +248,7 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   }
   nk_ = std::min(live, kMaxKeyframes);
   out.keyframes = nk_;
-  if (nk_ < 3) return out;
+  if (nk_ < 3) return false;
   auto newer = [&](int a, int b) { return map.keyframe(a).id > map.keyframe(b).id; };
   std::nth_element(kf_order_.begin(), kf_order_.begin() + (nk_ - 1), kf_order_.begin() + live, newer);
   int oldest = kf_order_[0], newest = kf_order_[0];
@@ -266,10 +266,14 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
     kf_T_[w] = map.keyframe(kf_order_[w]).T_w_b;
     kf_T_[w].t -= out.center;
   }
-  // Landmarks seen from at least three window keyframes, with their window observations. A landmark of two
-  // keyframes was created by an epipolar search at the map's poses: its two rays were chosen because they meet
-  // there, so it agrees with the map's unit whether or not it is a lookalike (a quarter of the 10 cm rig's window
-  // landmarks were, audited against rendered depth). A third keyframe's observation is a test it could fail.
+  return true;
+}
+
+// Landmarks seen from at least three window keyframes, with their window observations. A landmark of two
+// keyframes was created by an epipolar search at the map's poses: its two rays were chosen because they meet
+// there, so it agrees with the map's unit whether or not it is a lookalike. A third keyframe's observation is a
+// test it could fail.
+void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
   nl_ = 0;
   no_ = 0;
   for (int lm = 0; lm < map.landmarkCapacity() && nl_ < static_cast<int>(lm_p_.size()); ++lm) {
@@ -292,44 +296,55 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
       const int octave = std::clamp<int>(kp.octave, 0, static_cast<int>(octave_sigma_.size()) - 1);
       obs_[no_++] = Obs{static_cast<int16_t>(w), L.obs[j].cam, Vec2(kp.x, kp.y), 1.0 / octave_sigma_[octave]};
     }
-    lm_p_[nl_] = L.p_w - out.center;
+    lm_p_[nl_] = L.p_w - center;
     ++nl_;
   }
   lm_first_[nl_] = no_;
+}
+
+// The profile of the cost over log s in [-log max_ratio, log max_ratio], from the map's unit outwards both ways;
+// each factor starts from its neighbour's re-fitted window, scaled. Leaves the window at the best factor; false
+// when the best is at the end of the range (no minimum inside: the window says nothing).
+bool ScaleEstimator::profileScale(double max_ratio) {
+  const double umax = std::log(max_ratio);
+  const int steps = std::max(2, static_cast<int>(std::ceil(umax / std::log(kProfileRatio))));
+  const double du = umax / steps;
+  saveWindow(kf_start_, lm_start_);
+  hold_scale_ = true;
+  int best = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (const int dir : {1, -1}) {
+    restoreWindow(kf_start_, lm_start_);
+    for (int k = dir > 0 ? 0 : 1; k <= steps; ++k) {
+      if (k > 0) scaleWindow(std::exp(dir * du));
+      held_u_ = std::log(scaleOfPoses());
+      double c = 0, u_step = 0;
+      if (!refine(kProfileSteps, c, u_step)) break;
+      if (c < best_cost) {
+        best_cost = c;
+        best = dir * k;
+        saveWindow(kf_best_, lm_best_);
+      }
+    }
+  }
+  hold_scale_ = false;
+  if (best == -steps || best == steps) return false;  // no minimum inside the range: the window says nothing
+  restoreWindow(kf_best_, lm_best_);
+  return true;
+}
+
+ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
+  ScaleEstimate out;
+  if (!selectWindow(map, out)) return out;
+  collectLandmarks(map, out.center);
   out.landmarks = nl_;
   out.observations = no_;
   if (nl_ < 20) return out;
   const double scale_before = scaleOfPoses();
   if (!(scale_before > 0)) return out;
 
-  // 1. Coarse (max_ratio > 1): the profile of the cost over log s, from the map's unit outwards both ways; each
-  //    factor starts from its neighbour's re-fitted window, scaled.
-  if (max_ratio > 1.0) {
-    const double umax = std::log(max_ratio);
-    const int steps = std::max(2, static_cast<int>(std::ceil(umax / std::log(kProfileRatio))));
-    const double du = umax / steps;
-    saveWindow(kf_start_, lm_start_);
-    hold_scale_ = true;
-    int best = 0;
-    double best_cost = std::numeric_limits<double>::infinity();
-    for (const int dir : {1, -1}) {
-      restoreWindow(kf_start_, lm_start_);
-      for (int k = dir > 0 ? 0 : 1; k <= steps; ++k) {
-        if (k > 0) scaleWindow(std::exp(dir * du));
-        held_u_ = std::log(scaleOfPoses());
-        double c = 0, u_step = 0;
-        if (!refine(kProfileSteps, c, u_step)) break;
-        if (c < best_cost) {
-          best_cost = c;
-          best = dir * k;
-          saveWindow(kf_best_, lm_best_);
-        }
-      }
-    }
-    hold_scale_ = false;
-    if (best == -steps || best == steps) return out;  // no minimum inside the range: the window says nothing
-    restoreWindow(kf_best_, lm_best_);
-  }
+  // 1. Coarse (max_ratio > 1): the profile brings a map whose unit is far off into the basin.
+  if (max_ratio > 1.0 && !profileScale(max_ratio)) return out;
 
   // 2. Fine: Levenberg-Marquardt on the whole window, the scale free; the last system gives the marginal sigma.
   double c = 0, last_u_step = 0, chi2 = 0;

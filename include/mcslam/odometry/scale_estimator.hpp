@@ -69,6 +69,9 @@ class ScaleEstimator {
     double inv_sigma;
   };
   class Problem;  // the Levenberg-Marquardt problem of refine()
+  bool selectWindow(const Map& map, ScaleEstimate& out);    // keyframes: kf_T_, oldest_, out's window fields
+  void collectLandmarks(const Map& map, const Vec3& center);  // lm_p_, lm_first_, obs_
+  bool profileScale(double max_ratio);                         // the coarse search
   double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
   // Robust cost of landmark l at p, keyframes at kf_T_; p is refined first (two Gauss-Newton steps).
   double landmarkCost(int l, Vec3& p);
