@@ -4,16 +4,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mcslam/backend/levenberg_marquardt.hpp"
 #include "mcslam/backend/reprojection_residual.hpp"
 
 namespace mcslam::backend {
 
 namespace {
-// Levenberg-Marquardt scales the damping by diag(H), clamped as Ceres does so that a variable
-// without information still gets a (tiny) positive pivot.
-constexpr double kMinDiagonal = 1e-6;
-constexpr double kMaxDiagonal = 1e32;
-double clampDiagonal(double v) { return std::clamp(v, kMinDiagonal, kMaxDiagonal); }
+double clampDiagonal(double v) { return dampingDiagonal(v); }  // Marquardt's scaling
 
 // Smallest over largest eigenvalue of a landmark's 3x3 information: parallax.
 double conditioning(const Mat3& H) {

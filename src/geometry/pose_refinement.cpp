@@ -13,12 +13,12 @@ namespace {
 double huberLoss(double s, double k) { return s <= k * k ? s : 2.0 * k * std::sqrt(s) - k * k; }
 double huberWeight(double s, double k) { return s <= k * k ? 1.0 : k / std::sqrt(s); }
 
-// Marquardt's lambda from 1e-4 each round: x0.2 after a step that lowered the cost, x10 after one that did not;
-// a round ends after eight refusals in a row (each costs a full pass over the observations), after a step too
-// small to matter or one that lowered the cost by less than a billionth.
+// The trust region from 1e4 (mu = 1e-4) each round; a round ends after eight refusals in a row (each costs a
+// full pass over the observations), after a step too small to matter or one that lowered the cost by less than
+// a billionth.
 backend::LoopOptions loopOptions(const PoseRefinementOptions& options) {
   backend::LoopOptions loop;
-  loop.damping = backend::DampingPolicy::multiplicative(1e-4, 0.2, 10.0, 1e-9, INFINITY);
+  loop.damping = backend::DampingPolicy::trustRegion(1e4);
   loop.max_steps = options.iterations_per_round;
   loop.max_consecutive_rejections = 8;
   loop.function_tolerance = 1e-9;
@@ -78,10 +78,7 @@ class PoseRefiner::Problem final : public backend::LeastSquaresProblem {
       : refiner_(refiner), obs_(obs), T_w_b_(T_w_b), current_(current), robust_(robust) {}
   bool linearize() override { return true; }
   double cost() const override { return current_.cost; }
-  void buildDampedSystem(double lambda) override {
-    A_ = current_.H;
-    A_.diagonal() += lambda * (current_.H.diagonal().array() + 1e-12).matrix();
-  }
+  void buildDampedSystem(double mu) override { backend::dampedMatrix(current_.H, mu, A_); }
   bool solveStep() override {
     delta_ = A_.ldlt().solve(-current_.g);
     return delta_.allFinite();

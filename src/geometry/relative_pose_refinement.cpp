@@ -121,10 +121,7 @@ class RelativePoseProblem final : public backend::LeastSquaresProblem {
     return true;
   }
   double cost() const override { return c_; }
-  void buildDampedSystem(double lambda) override {
-    A_ = H_;
-    A_.diagonal() += lambda * (H_.diagonal().array() + 1e-12).matrix();
-  }
+  void buildDampedSystem(double mu) override { backend::dampedMatrix(H_, mu, A_); }
   bool solveStep() override {
     step_ = A_.ldlt().solve(-g_);
     return step_.allFinite();
@@ -186,9 +183,8 @@ SE3 refineRelativePose(std::span<const RayPair> matches, std::span<const uint8_t
   SE3 T = start;
   if (!(T.t.norm() > 0)) return T;
   RelativePoseProblem problem(matches, mask, T, fixed_scale, 2.0 * options.bearing_sigma_rad);
-  // Marquardt's lambda: x0.2 after a step that lowered the cost, x10 after one that did not, up to 1e10.
   backend::LoopOptions loop;
-  loop.damping = backend::DampingPolicy::multiplicative(1e-4, 0.2, 10.0, 1e-9, std::nextafter(1e10, 0.0));
+  loop.damping = backend::DampingPolicy::trustRegion(1e4);
   loop.max_steps = 100;
   loop.small_step = backend::LoopOptions::SmallStep::EndsOnceTaken;
   loop.min_step_norm = 1e-12;

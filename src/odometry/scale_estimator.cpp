@@ -16,7 +16,8 @@ namespace {
 // that the cost stays continuous enough to search.
 constexpr double kMissingSigmas = 10.0;
 constexpr int kRefineSteps = 6;
-constexpr double kMinDamping = 1e-6, kMaxDamping = 1e4;
+constexpr double kInitialRadius = 1e6;
+constexpr int kMaxRefusals = 10;
 // The profile's spacing in s, and the steps that re-fit the window at each factor (from its neighbour's fit): the
 // profile only chooses the basin, the free refinement then finds the minimum in it.
 constexpr double kProfileRatio = 1.4;
@@ -118,8 +119,8 @@ class ScaleEstimator::Problem final : public backend::LeastSquaresProblem {
     return true;
   }
   double cost() const override { return c_; }
-  void buildDampedSystem(double lambda) override { lambda_ = lambda; }
-  bool solveStep() override { return e_.dampedStep(lambda_, step_); }
+  void buildDampedSystem(double mu) override { mu_ = mu; }
+  bool solveStep() override { return e_.dampedStep(mu_, step_); }
   double stepNorm() const override { return step_.norm(); }
   double modelCostDecrease(double) const override { return -(e_.b_.dot(step_) + 0.5 * step_.dot(e_.S_ * step_)); }
   bool evaluateTrial(double& cost) override {
@@ -139,17 +140,17 @@ class ScaleEstimator::Problem final : public backend::LeastSquaresProblem {
 
  private:
   ScaleEstimator& e_;
-  double c_, trial_ = 0, lambda_ = 0, u_step_ = 0;
+  double c_, trial_ = 0, mu_ = 0, u_step_ = 0;
   ReducedVec step_;
 };
 
 bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
-  // Marquardt's lambda relative to the diagonal: a step that does not lower the cost is retried with ten times
-  // more, up to the largest (then the window is at its minimum); after a step, a tenth of the lambda taken.
+  // The trust region from mu = 1e-6; ten refusals in a row (each re-fits every landmark) end it: the window is at
+  // its minimum.
   backend::LoopOptions loop;
-  loop.damping = backend::DampingPolicy::multiplicative(kMinDamping, 10.0, 10.0, kMinDamping, kMaxDamping);
-  loop.damping.accept_divisor = 100.0;
+  loop.damping = backend::DampingPolicy::trustRegion(kInitialRadius);
   loop.max_steps = steps;
+  loop.max_consecutive_rejections = kMaxRefusals;
   Problem problem(*this);
   const backend::LoopSummary summary = backend::minimize(problem, loop);
   c = problem.cost();
@@ -213,8 +214,7 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
     if (f >= 0 && d.norm() > 0) g_.segment<3>(6 * f) = kf_T_[w].R.transpose() * d / (d.norm() * sum);
   }
   // The variance of u (in units of the pixel sigmas) from the undamped system. The damping of dampedStep() only
-  // steadies the step: where the window does not constrain the scale it would pose as information (measured: a straight
-  // synthetic window's sigma 5360% became 21%; a window of the rendered 10 cm rig 93% became 3.8%).
+  // steadies the step: where the window does not constrain the scale it would pose as information.
   const Eigen::LDLT<Reduced> exact(S_);
   scale_variance_ = exact.info() == Eigen::Success ? g_.dot(exact.solve(g_)) : INFINITY;
   if (!(scale_variance_ > 0)) scale_variance_ = INFINITY;  // singular or indefinite: the scale is not observed
@@ -226,9 +226,8 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
   return b_.allFinite() && std::isfinite(scale_variance_);
 }
 
-bool ScaleEstimator::dampedStep(double lambda, ReducedVec& step) {
-  damped_ = S_;
-  damped_.diagonal().array() += 1e-9 + lambda * S_.diagonal().array();
+bool ScaleEstimator::dampedStep(double mu, ReducedVec& step) {
+  backend::dampedMatrix(S_, mu, damped_);
   const Eigen::LDLT<Reduced> ldlt(damped_);
   if (ldlt.info() != Eigen::Success) return false;
   step = ldlt.solve(-b_);
@@ -378,7 +377,7 @@ bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t
   if (info() > 0 && (log_scale - x) * (log_scale - x) > 9.0 * (sigma * sigma + 1.0 / info())) {
     // One window off by 3 sigma is an outlier; several in a row mean the map's scale moved. Once converged,
     // they must include two that share no keyframe: overlapping windows in a map a fast corner broke agree with
-    // each other (three at 0.79 +- 4% restarted the combination the wrong way: the map had shrunk).
+    // each other.
     if (rejected_++ == 0) first_rejected_newest_ = newest_id;
     const bool independent = drift_variance_ == 0 || oldest_id > first_rejected_newest_;
     if (rejected_ < kRestartAfter || !independent) return false;
@@ -393,10 +392,10 @@ bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t
   }
   if (drift_variance_ > 0 && committed_.info > 0 && sigma * sigma * committed_.info < 1.0) {
     // The unit does not only random-walk: it jumps where the scene leaves the rig one camera looking ahead (side
-    // cameras before blank walls, rendered 10 cm rig: 20% in 20 frames, 4 sigma of the drift). A window more
+    // cameras before blank walls). A window more
     // certain than the committed part that disagrees with it by more than both sigmas allow raises the committed
     // variance to what the disagreement shows (covariance matching). Only then: a turn's first windows, less
-    // certain, often disagree with both (one at 0.65 +- 15% rescaled by 0.68 a map that was within 2%).
+    // certain, often disagree with both.
     const double nu = log_scale - committed_.x, excess = nu * nu - sigma * sigma;
     if (excess * committed_.info > 1.0) committed_.info = 1.0 / excess;
   }

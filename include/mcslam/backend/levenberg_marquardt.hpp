@@ -7,6 +7,7 @@
 // complement), the damped solve and the cost at a trial step. The problem is called a handful of times per
 // trial, never per residual: a virtual interface costs nothing measurable here, and keeps one compiled loop.
 // Allocates nothing.
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <limits>
@@ -104,5 +105,17 @@ class LeastSquaresProblem {
 };
 
 LoopSummary minimize(LeastSquaresProblem& problem, const LoopOptions& options);
+
+// Marquardt's scaling of the damping (the window solver's, and Ceres's): mu times the diagonal of H, clamped so
+// that a variable without information still gets a (tiny) positive pivot and a huge one no infinite damping.
+constexpr double kMinDampingDiagonal = 1e-6, kMaxDampingDiagonal = 1e32;
+inline double dampingDiagonal(double h) { return std::clamp(h, kMinDampingDiagonal, kMaxDampingDiagonal); }
+
+// A = H + mu * D for a dense H (D: dampingDiagonal of H's diagonal).
+template <class Matrix>
+void dampedMatrix(const Matrix& H, double mu, Matrix& A) {
+  A = H;
+  for (int i = 0; i < static_cast<int>(H.rows()); ++i) A(i, i) += mu * dampingDiagonal(H(i, i));
+}
 
 }  // namespace mcslam::backend
