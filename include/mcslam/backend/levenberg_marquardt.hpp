@@ -15,7 +15,9 @@
 namespace mcslam::backend {
 
 // How the damping moves. The problem receives it as one number: lambda (Marquardt) or mu = 1 / radius (trust
-// region), and adds it times its diagonal scaling to the normal equations.
+// region), and adds it times its diagonal scaling (dampedMatrix) to the normal equations. Every optimizer of the
+// core uses the trust region; Marquardt's multiplicative lambda stays as a kind for comparison
+// (docs/design/optim.md).
 struct DampingPolicy {
   enum class Kind {
     // Marquardt's lambda: a trial is taken when it lowers the cost; lambda then becomes
