@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "mcslam/backend/reprojection_residual.hpp"
-#include "symmetric_eigen.hpp"
 
 namespace mcslam::backend {
 
@@ -38,7 +37,8 @@ Mat6 pseudoInverse(const Mat6& H, double scale) {
 }
 }  // namespace
 
-Marginalizer::Marginalizer(const WindowStorage& window, const SolverOptions& options) : options_(options) {
+Marginalizer::Marginalizer(const WindowStorage& window, const SolverOptions& options)
+    : options_(options), schur_(window.numCameras() + 1, window.numCameras() + 1) {
   const int C = window.numCameras();
   ext_var_of_camera_.assign(C, -1);
   for (int c = 0; c < C; ++c) {
@@ -46,17 +46,11 @@ Marginalizer::Marginalizer(const WindowStorage& window, const SolverOptions& opt
   }
   const int n = 6 * num_ext_vars_;
   obs_.resize(C);
-  W_.resize(C + 1);
-  W_block_.resize(C + 1);
   H_.setZero(6 + n, 6 + n);
   g_.setZero(6 + n);
   K_.setZero(n, 6);
   Hn_.setZero(n, n);
   gn_.setZero(n);
-  d_.setZero(n);
-  tmp_.setZero(n);
-  scratch_.setZero(n, n);
-  V_.setZero(n, n);
 }
 
 bool Marginalizer::isExclusiveTo(const WindowStorage& window, int landmark, int keyframe) const {
@@ -128,42 +122,28 @@ void Marginalizer::accumulateExclusiveLandmarks(const WindowStorage& window, int
     // Two views of one keyframe without parallax tell nothing after elimination: skip.
     if (n < 2 || conditioning(Hll) < options_.min_landmark_conditioning) continue;
 
-    // Direct terms, blocks [0] pose and [6 + 6v] extrinsic v; W_t = H_{t,l}.
-    int num_blocks = 0;
-    auto touch = [&](int row) {
-      for (int t = 0; t < num_blocks; ++t) {
-        if (W_block_[t] == row) return t;
-      }
-      W_block_[num_blocks] = row;
-      W_[num_blocks].setZero();
-      return num_blocks++;
-    };
+    // Direct terms, blocks [0] pose and [1 + v] extrinsic v (rows 6 + 6v); their couplings H_{t,l}.
+    schur_.beginPoint();
     for (int i = 0; i < n; ++i) {
       const ObservationLin& x = obs_[i];
       c_ += 0.5 * x.r.squaredNorm();
       H_.topLeftCorner<6, 6>().noalias() += x.Jp.transpose() * x.Jp;
       g_.head<6>().noalias() += x.Jp.transpose() * x.r;
-      W_[touch(0)].noalias() += x.Jp.transpose() * x.Jl;
+      schur_.coupling(0).noalias() += x.Jp.transpose() * x.Jl;
       if (x.ext_var < 0) continue;
       const int e = 6 + 6 * x.ext_var;
       H_.block<6, 6>(e, e).noalias() += x.Je.transpose() * x.Je;
       H_.block<6, 6>(0, e).noalias() += x.Jp.transpose() * x.Je;
       H_.block<6, 6>(e, 0).noalias() += x.Je.transpose() * x.Jp;
       g_.segment<6>(e).noalias() += x.Je.transpose() * x.r;
-      W_[touch(e)].noalias() += x.Je.transpose() * x.Jl;
+      schur_.coupling(1 + x.ext_var).noalias() += x.Je.transpose() * x.Jl;
     }
     pose_scale_ = std::max(pose_scale_, H_.topLeftCorner<6, 6>().diagonal().maxCoeff());
 
     // Eliminate the landmark: H -= W H_ll^-1 W^T, g -= W H_ll^-1 g_l (H_ll is well conditioned here).
     const Mat3 Hinv = Hll.llt().solve(Mat3::Identity());
     c_ -= 0.5 * gl.dot(Hinv * gl);
-    for (int a = 0; a < num_blocks; ++a) {
-      const Eigen::Matrix<double, 6, 3> V = W_[a] * Hinv;
-      g_.segment<6>(W_block_[a]).noalias() -= V * gl;
-      for (int b = 0; b < num_blocks; ++b) {
-        H_.block<6, 6>(W_block_[a], W_block_[b]).noalias() -= V * W_[b].transpose();
-      }
-    }
+    schur_.eliminate(Hinv, gl, H_, g_);
   }
 }
 
@@ -180,43 +160,7 @@ void Marginalizer::foldIntoPrior(WindowStorage& window, MarginalizationPrior& pr
   gn_.noalias() -= K_ * g_.head<6>();
   double c = c_ - 0.5 * g_.head<6>().dot(P * g_.head<6>());
 
-  // Re-express around the fixed linearization point: the new terms were linearized at the
-  // current d, E(d') = c + gn^T (d' - d) + 0.5 (d' - d)^T Hn (d' - d).
-  for (int cam = 0; cam < static_cast<int>(ext_var_of_camera_.size()); ++cam) {
-    const int v = ext_var_of_camera_[cam];
-    if (v >= 0) d_.segment<6>(6 * v) = window.extrinsics[cam].d;
-  }
-  tmp_.noalias() = Hn_ * d_;
-  prior.c += c - gn_.dot(d_) + 0.5 * d_.dot(tmp_);
-  prior.b += gn_ - tmp_;
-  prior.H += Hn_;
-
-  // Symmetric PSD: symmetrize, clamp eigenvalues that rounding pushed below zero, and remove
-  // the gradient's component in the null space (it would pull the extrinsics without bound).
-  scratch_ = prior.H.transpose();
-  prior.H += scratch_;
-  prior.H *= 0.5;
-  jacobiEigen(prior.H, V_);  // prior.H now holds the eigenvalues on its diagonal
-  double top = 0;
-  for (int i = 0; i < n; ++i) top = std::max(top, prior.H(i, i));
-  const double floor = kRelativeRankTolerance * top;
-  tmp_.noalias() = V_.transpose() * prior.b;
-  scratch_ = V_;
-  for (int i = 0; i < n; ++i) {
-    const double lambda = prior.H(i, i);
-    if (!(lambda > floor)) tmp_(i) = 0;
-    scratch_.col(i) *= lambda > floor ? lambda : 0.0;
-  }
-  prior.b.noalias() = V_ * tmp_;
-  prior.H.noalias() = scratch_ * V_.transpose();
-  prior.H.triangularView<Eigen::StrictlyLower>() = prior.H.transpose();  // exactly symmetric
-  prior.empty = false;
-
-  // Extrinsics that received information keep their linearization point from now on.
-  for (int cam = 0; cam < static_cast<int>(ext_var_of_camera_.size()); ++cam) {
-    const int v = ext_var_of_camera_[cam];
-    if (v >= 0 && Hn_.block<6, 6>(6 * v, 6 * v).trace() > 0) window.extrinsics[cam].in_prior = true;
-  }
+  prior.absorb(Hn_, gn_, c, window);
 }
 
 }  // namespace mcslam::backend

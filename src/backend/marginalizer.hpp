@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "marginalization_prior.hpp"
+#include "mcslam/backend/schur_accumulator.hpp"
 #include "window_storage.hpp"
 
 namespace mcslam::backend {
@@ -39,17 +40,14 @@ class Marginalizer {
   int num_ext_vars_ = 0;
   std::vector<int> ext_var_of_camera_;
   std::vector<ObservationLin> obs_;  // one landmark's observations (at most one per camera)
-  std::vector<Eigen::Matrix<double, 6, 3>> W_;
-  std::vector<int> W_block_;
+  SchurAccumulator schur_;  // eliminates the exclusive landmarks
   Eigen::MatrixXd H_;  // (6 + 6 n) square: [pose | extrinsics]
   Eigen::VectorXd g_;
   double c_ = 0;
   double pose_scale_ = 0;  // largest diagonal of the pose block before eliminating landmarks
   Eigen::MatrixXd K_;      // H_e0 * H_00^+
   Eigen::MatrixXd Hn_;
-  Eigen::VectorXd gn_, d_, tmp_;
-  Eigen::MatrixXd scratch_;
-  Eigen::MatrixXd V_;  // eigenvectors of the prior
+  Eigen::VectorXd gn_;
 };
 
 }  // namespace mcslam::backend

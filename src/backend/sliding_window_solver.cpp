@@ -2,10 +2,12 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "marginalizer.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/backend/levenberg_marquardt.hpp"
 #include "mcslam/backend/reprojection_residual.hpp"
 #include "reduced_system_solver.hpp"
 #include "window_linearization.hpp"
@@ -29,10 +31,6 @@ const char* statusName(Status s) {
 }
 
 namespace {
-int countFreeExtrinsics(const Rig& rig, const SolverOptions& options) {
-  return options.refine_extrinsics && rig.size() > 1 ? rig.size() - 1 : 0;
-}
-
 // Configuration errors surface at construction, never in the hot path.
 const Rig& validated(const Rig& rig, const WindowCapacity& cap, const SolverOptions& o) {
   auto fail = [](const std::string& field, double value) {
@@ -57,7 +55,7 @@ struct SlidingWindowSolver::Impl {
   Impl(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& opts)
       : options(opts),
         window(validated(rig, capacity, opts), capacity, opts),
-        prior(6 * countFreeExtrinsics(rig, opts)),
+        prior(window),
         linearization(window, opts),
         reduced(capacity.max_keyframes + rig.size()),
         marginalizer(window, opts) {
@@ -69,11 +67,6 @@ struct SlidingWindowSolver::Impl {
 
   SolveSummary solve(int max_iterations);
   void classifyOutliers();
-  // What the marginalization prior knew of this extrinsic was gathered at a linearization point now judged wrong:
-  // the extrinsic is marginalized out of the prior (Schur complement: what it told about the others stays) and
-  // unlinked, so it is linearized afresh. Rare (an outside re-estimation): the temporaries may allocate.
-  void forgetExtrinsicInPrior(int camera);
-
   SolverOptions options;
   WindowStorage window;
   MarginalizationPrior prior;
@@ -86,6 +79,43 @@ struct SlidingWindowSolver::Impl {
   std::vector<SE3> T_c_b;
 };
 
+namespace {
+// The window's Levenberg-Marquardt problem: the linearization's reduced system, solved by CHOLMOD.
+class WindowProblem final : public LeastSquaresProblem {
+ public:
+  WindowProblem(WindowStorage& window, MarginalizationPrior& prior, WindowLinearization& lin,
+                ReducedSystemSolver& reduced)
+      : window_(window), prior_(prior), lin_(lin), reduced_(reduced) {}
+  bool linearize() override {
+    lin_.linearize(window_, prior_, /*select_landmarks=*/first_);
+    first_ = false;
+    return true;
+  }
+  double cost() const override { return lin_.cost(); }
+  void buildDampedSystem(double mu) override { lin_.buildReducedSystem(window_, mu, prior_); }
+  double maxGradient() const override { return lin_.maxGradient(); }
+  bool solveStep() override {
+    if (lin_.numBlocks() > 0) reduced_.setStructure(lin_.numBlocks(), lin_.blockPattern());
+    const bool solved =
+        lin_.numBlocks() == 0 || reduced_.solve(lin_.reducedMatrix(), lin_.reducedRhs(), lin_.cameraStep());
+    if (solved) lin_.backSubstitute();
+    return solved;
+  }
+  double stepNorm() const override { return std::sqrt(lin_.stepSquaredNorm()); }
+  double stateNorm() const override { return std::sqrt(lin_.stateSquaredNorm(window_)); }
+  double modelCostDecrease(double mu) const override { return lin_.modelCostDecrease(mu); }
+  bool evaluateTrial(double& cost) override { return lin_.evaluateTrial(window_, prior_, cost); }
+  void acceptTrial() override { lin_.commitTrial(window_); }
+
+ private:
+  WindowStorage& window_;
+  MarginalizationPrior& prior_;
+  WindowLinearization& lin_;
+  ReducedSystemSolver& reduced_;
+  bool first_ = true;
+};
+}  // namespace
+
 SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
   SolveSummary summary;
   const int analyses_before = reduced.analyses();
@@ -96,64 +126,21 @@ SolveSummary SlidingWindowSolver::Impl::solve(int max_iterations) {
     summary.outliers = static_cast<int>(outliers.size());
     return summary;
   }
-  lin.linearize(window, prior, /*select_landmarks=*/true);
-  double cost = lin.cost();
-  summary.initial_cost = cost;
-
   // Levenberg-Marquardt in trust-region form: mu = 1 / radius, the radius grows with good
   // steps (by the gain ratio) and shrinks by a growing factor after rejected ones.
-  double radius = options.initial_trust_radius;
-  double decrease_factor = 2.0;
-  constexpr double kMinRelativeDecrease = 1e-3;
-  constexpr double kMinRadius = 1e-32, kMaxRadius = 1e16;
-  for (int iter = 0; iter < max_iterations; ++iter) {
-    const double mu = 1.0 / radius;
-    lin.buildReducedSystem(mu, prior);
-    if (lin.maxGradient() <= options.gradient_tolerance) {
-      summary.converged = true;
-      break;
-    }
-    if (lin.numBlocks() > 0) reduced.setStructure(lin.numBlocks(), lin.blockPattern());
-    ++summary.iterations;
-    const bool solved =
-        lin.numBlocks() == 0 || reduced.solve(lin.reducedMatrix(), lin.reducedRhs(), lin.cameraStep());
-    bool accepted = false;
-    if (solved) {
-      lin.backSubstitute();
-      const double step2 = lin.stepSquaredNorm();
-      const double tol = options.parameter_tolerance;
-      if (std::sqrt(step2) <= tol * (std::sqrt(lin.stateSquaredNorm(window)) + tol)) {
-        summary.converged = true;
-        break;
-      }
-      const double predicted = lin.modelCostDecrease(mu);
-      double new_cost = 0;
-      if (predicted > 0 && lin.evaluateTrial(window, prior, new_cost)) {
-        const double gain = (cost - new_cost) / predicted;
-        if (gain > kMinRelativeDecrease) {
-          accepted = true;
-          lin.commitTrial(window);
-          ++summary.accepted_steps;
-          const double previous = cost;
-          lin.linearize(window, prior, /*select_landmarks=*/false);
-          cost = lin.cost();
-          const double t = 2.0 * gain - 1.0;
-          radius = std::min(kMaxRadius, radius / std::max(1.0 / 3.0, 1.0 - t * t * t));
-          decrease_factor = 2.0;
-          if ((previous - cost) <= options.function_tolerance * previous) {
-            summary.converged = true;
-            break;
-          }
-        }
-      }
-    }
-    if (!accepted) {
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
-      if (radius < kMinRadius) break;
-    }
-  }
-  summary.final_cost = cost;
+  LoopOptions loop;
+  loop.damping = DampingPolicy::trustRegion(options.initial_trust_radius);
+  loop.max_solves = max_iterations;
+  loop.gradient_tolerance = options.gradient_tolerance;
+  loop.parameter_tolerance = options.parameter_tolerance;
+  loop.function_tolerance = options.function_tolerance;
+  WindowProblem problem(window, prior, lin, reduced);
+  const LoopSummary s = minimize(problem, loop);
+  summary.iterations = s.solves;
+  summary.accepted_steps = s.steps;
+  summary.initial_cost = s.initial_cost;
+  summary.final_cost = s.final_cost;
+  summary.converged = s.converged;
   summary.symbolic_analyses = reduced.analyses() - analyses_before;
   summary.landmarks_used = lin.landmarksUsed();
   summary.landmarks_skipped = lin.landmarksSkipped();
@@ -178,27 +165,6 @@ void SlidingWindowSolver::Impl::classifyOutliers() {
                                                 lm.p_w, ob.uv, ob.inv_sigma, r, nullptr);
     if (!ok || r.squaredNorm() > options.outlier_chi2) outliers.push_back({kf.id, lm.id, ob.camera});
   }
-}
-
-void SlidingWindowSolver::Impl::forgetExtrinsicInPrior(int camera) {
-  int v = 0;
-  for (int c = 0; c < camera; ++c) v += window.extrinsics[c].variable ? 1 : 0;
-  const int k = 6 * v;
-  // Pseudo-inverse of the camera's block (it may hold information in some directions only).
-  const Eigen::SelfAdjointEigenSolver<Mat6> eig(prior.H.block<6, 6>(k, k));
-  const double floor = 1e-12 * std::max(1.0, eig.eigenvalues().cwiseAbs().maxCoeff());
-  Vec6 inv = Vec6::Zero();
-  for (int i = 0; i < 6; ++i) inv(i) = eig.eigenvalues()(i) > floor ? 1.0 / eig.eigenvalues()(i) : 0.0;
-  const Mat6 P = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
-  const Eigen::MatrixXd Hc = prior.H.middleCols<6>(k);  // column block of the camera
-  const Vec6 bc = prior.b.segment<6>(k);
-  prior.c -= 0.5 * bc.dot(P * bc);
-  prior.b.noalias() -= Hc * (P * bc);
-  prior.H.noalias() -= Hc * P * Hc.transpose();
-  prior.H.middleCols<6>(k).setZero();
-  prior.H.middleRows<6>(k).setZero();
-  prior.b.segment<6>(k).setZero();
-  window.extrinsics[camera].in_prior = false;
 }
 
 SlidingWindowSolver::SlidingWindowSolver(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& options)
@@ -256,7 +222,7 @@ Status SlidingWindowSolver::setExtrinsic(int camera, const SE3& T_b_c, bool keep
   }
   if (!T_b_c.R.allFinite() || !T_b_c.t.allFinite()) return Status::InvalidValue;
   ExtrinsicState& e = impl_->window.extrinsics[camera];
-  if (e.in_prior) impl_->forgetExtrinsicInPrior(camera);
+  if (e.in_prior) impl_->prior.forgetExtrinsic(camera, impl_->window);
   e.T = T_b_c;
   e.T.normalize();
   e.T_lin = e.T;

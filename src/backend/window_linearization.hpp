@@ -8,7 +8,12 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include <array>
+
+#include "calibration_prior.hpp"
 #include "marginalization_prior.hpp"
+#include "mcslam/backend/schur_accumulator.hpp"
+#include "window_scale_hold.hpp"
 #include "window_storage.hpp"
 
 namespace mcslam::backend {
@@ -23,12 +28,12 @@ class WindowLinearization {
   bool prepare(const WindowStorage& window, int fixed_oldest, bool hold_scale);
   // Residuals, robust weights and Jacobians at the current state. `select_landmarks` (first call
   // of a solve) drops observations that do not project and landmarks that are not constrained.
-  void linearize(const WindowStorage& window, const MarginalizationPrior& prior, bool select_landmarks);
+  void linearize(const WindowStorage& window, MarginalizationPrior& prior, bool select_landmarks);
   double cost() const { return cost_; }
   double maxGradient() const;
 
   // Damped reduced system (H_cc + mu D_c - W (H_ll + mu D_l)^-1 W^T) and its right-hand side.
-  void buildReducedSystem(double mu, const MarginalizationPrior& prior);
+  void buildReducedSystem(const WindowStorage& window, double mu, const MarginalizationPrior& prior);
   int numBlocks() const { return num_blocks_; }
   int maxBlocks() const { return max_blocks_; }
   const uint8_t* blockPattern() const { return pattern_.data(); }
@@ -78,19 +83,22 @@ class WindowLinearization {
   };
 
   void updateTransforms(const WindowStorage& window);
-  double priorCost(const WindowStorage& window, const MarginalizationPrior& prior, bool trial) const;
-  // Summed distances of the held keyframes from the anchor (trial poses or the window's).
-  double heldDistance(const WindowStorage& window, bool trial) const;
-  double scaleResidual(double held_distance) const {
-    return (std::log(held_distance) - log_held_distance_) / kScaleSigma;
+  // The observations of landmark L at the current state; its cost and valid count, and its 3x3 information.
+  double linearizeLandmark(const WindowStorage& window, LandmarkLin& L, bool select, int& valid, Mat3& H);
+  // Adds landmark L's part to the reduced system (damped by mu) and eliminates it.
+  void eliminateLandmark(LandmarkLin& L, double mu);
+  WindowVariables variables(const WindowStorage& window) const;
+  // The extra terms, in the order their costs are summed.
+  std::array<WindowTerm*, 3> terms(MarginalizationPrior& prior) { return {&scale_hold_, &calibration_prior_, &prior}; }
+  std::array<const WindowTerm*, 3> terms(const MarginalizationPrior& prior) const {
+    return {&scale_hold_, &calibration_prior_, &prior};
   }
+  double termsCost(const WindowStorage& window, const MarginalizationPrior& prior, bool trial) const;
 
   const SolverOptions options_;
   int max_blocks_;
   int ld_;
   int num_cameras_;
-  int num_ext_vars_ = 0;
-  std::vector<int> ext_var_of_camera_;
 
   // Variables of this solve.
   std::vector<int> pose_block_;  // per keyframe slot
@@ -99,7 +107,7 @@ class WindowLinearization {
   std::vector<SE3> T_b_w_;       // per keyframe slot
   std::vector<SE3> T_c_b_;       // per camera, current
   std::vector<SE3> T_c_b_jac_;   // per camera, where Jacobians are evaluated (first estimate)
-  std::vector<bool> use_fej_;
+  std::vector<uint8_t> use_fej_;
 
   std::vector<LandmarkLin> landmarks_;
   int num_landmarks_ = 0;
@@ -109,10 +117,10 @@ class WindowLinearization {
   // an extrinsic block and this would be a third of lin_'s memory, never read).
   std::vector<ExtrinsicJacobian> je_;
   int num_refs_ = 0;
-  std::vector<Vec6> prior_r_;    // calibration prior per camera
-  std::vector<Mat6> prior_J_;
   double cost_ = 0;
   int landmarks_used_ = 0, landmarks_skipped_ = 0, residuals_used_ = 0;
+  CalibrationPrior calibration_prior_;
+  WindowScaleHold scale_hold_;
 
   // Reduced camera system.
   Eigen::MatrixXd S_;
@@ -120,24 +128,9 @@ class WindowLinearization {
   Eigen::VectorXd D_c_;     // clamped diagonal of H_cc
   Eigen::VectorXd rhs_;     // -(reduced gradient)
   Eigen::VectorXd dx_c_;
-  Eigen::VectorXd d_current_;         // stacked extrinsic d at the linearization
-  mutable Eigen::VectorXd d_eval_;    // stacked d where the prior is evaluated
   double max_gradient_ = 0;
   std::vector<uint8_t> pattern_;
-  std::vector<Eigen::Matrix<double, 6, 3>> W_;  // per touched block of one landmark
-  std::vector<int> touched_;
-  std::vector<int> touched_slot_;
-
-  // The window's unit (hold_window_scale): anchor = oldest keyframe slot, held = the slots between it and the
-  // newest; their pose blocks and the residual's Jacobian rows (6 per block, translation part only).
-  static constexpr double kScaleSigma = 1e-4;  // of log(summed distances): stiff
-  bool hold_scale_ = false;
-  int scale_anchor_ = -1;
-  std::vector<int> held_slots_;
-  int num_held_ = 0;
-  double log_held_distance_ = 0;
-  double scale_r_ = 0;
-  std::vector<Vec6> scale_J_;  // per held slot (index into held_slots_)
+  SchurAccumulator schur_;  // eliminates the landmarks
 
   // Trial state.
   std::vector<SE3> kf_trial_;

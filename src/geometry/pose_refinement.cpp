@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "mcslam/backend/levenberg_marquardt.hpp"
+
 namespace mcslam {
 
 namespace {
@@ -10,6 +12,21 @@ namespace {
 // Huber loss of a squared whitened error s, threshold k (in sigmas).
 double huberLoss(double s, double k) { return s <= k * k ? s : 2.0 * k * std::sqrt(s) - k * k; }
 double huberWeight(double s, double k) { return s <= k * k ? 1.0 : k / std::sqrt(s); }
+
+// The trust region from 1e4 (mu = 1e-4) each round; a round ends after eight refusals in a row (each costs a
+// full pass over the observations), after a step too small to matter or one that lowered the cost by less than
+// a billionth.
+backend::LoopOptions loopOptions(const PoseRefinementOptions& options) {
+  backend::LoopOptions loop;
+  loop.damping = backend::DampingPolicy::trustRegion(1e4);
+  loop.max_steps = options.iterations_per_round;
+  loop.max_consecutive_rejections = 8;
+  loop.function_tolerance = 1e-9;
+  loop.small_step = backend::LoopOptions::SmallStep::EndsAfterTrial;
+  loop.min_step_norm = 1e-9;
+  loop.stop_on_failed_solve = true;
+  return loop;
+}
 
 }  // namespace
 
@@ -53,6 +70,46 @@ PoseRefiner::Pass PoseRefiner::evaluate(std::span<const PoseObservation> obs, co
   return pass;
 }
 
+// Levenberg-Marquardt on the pose at one outlier classification: the current pass is the linearization at
+// T_w_b, and an accepted trial's pass is already the next one.
+class PoseRefiner::Problem final : public backend::LeastSquaresProblem {
+ public:
+  Problem(PoseRefiner& refiner, std::span<const PoseObservation> obs, SE3& T_w_b, Pass& current, bool robust)
+      : refiner_(refiner), obs_(obs), T_w_b_(T_w_b), current_(current), robust_(robust) {}
+  bool linearize() override { return true; }
+  double cost() const override { return current_.cost; }
+  void buildDampedSystem(double mu) override { backend::dampedMatrix(current_.H, mu, A_); }
+  bool solveStep() override {
+    delta_ = A_.ldlt().solve(-current_.g);
+    return delta_.allFinite();
+  }
+  double stepNorm() const override { return delta_.norm(); }
+  double modelCostDecrease(double) const override {
+    return -(current_.g.dot(delta_) + 0.5 * delta_.dot(current_.H * delta_));
+  }
+  bool evaluateTrial(double& cost) override {
+    candidate_ = T_w_b_ * SE3::exp(delta_);
+    trial_ = refiner_.evaluate(obs_, candidate_.inverse(), robust_, false, true);
+    cost = trial_.cost;
+    return true;
+  }
+  void acceptTrial() override {
+    T_w_b_ = candidate_;
+    current_ = trial_;
+  }
+
+ private:
+  PoseRefiner& refiner_;
+  std::span<const PoseObservation> obs_;
+  SE3& T_w_b_;
+  Pass& current_;
+  const bool robust_;
+  Mat6 A_;
+  Vec6 delta_;
+  SE3 candidate_;
+  Pass trial_;
+};
+
 PoseRefinementResult PoseRefiner::refine(std::span<const PoseObservation> obs, const SE3& initial_T_w_b,
                                          std::span<const uint8_t> initial_inliers) {
   PoseRefinementResult result;
@@ -64,35 +121,11 @@ PoseRefinementResult PoseRefiner::refine(std::span<const PoseObservation> obs, c
   SE3 T_w_b = initial_T_w_b;
   auto robustRound = [&](int round) { return round < options_.robust_rounds; };
   Pass current = evaluate(obs, T_w_b.inverse(), robustRound(0), false, true);
+  const backend::LoopOptions loop = loopOptions(options_);
   int round = 0;
   for (; round < options_.rounds; ++round) {
-    const bool robust = robustRound(round);
-    double lambda = 1e-4;
-    for (int it = 0; it < options_.iterations_per_round; ++it) {
-      // Levenberg-Marquardt: damp until the cost goes down. A step too small to matter ends the
-      // round at once (each refused trial costs a full pass over the observations).
-      bool improved = false, converged = false;
-      for (int trial = 0; trial < 8 && !improved && !converged; ++trial) {
-        Mat6 A = current.H;
-        A.diagonal() += lambda * (current.H.diagonal().array() + 1e-12).matrix();
-        const Vec6 delta = A.ldlt().solve(-current.g);
-        if (!delta.allFinite()) break;
-        converged = delta.norm() < 1e-9;
-        ++result.iterations;
-        const SE3 candidate = T_w_b * SE3::exp(delta);
-        const Pass trial_pass = evaluate(obs, candidate.inverse(), robust, false, true);
-        if (trial_pass.cost < current.cost) {
-          converged = converged || current.cost - trial_pass.cost < 1e-9 * current.cost;
-          T_w_b = candidate;
-          current = trial_pass;
-          lambda = std::max(lambda * 0.2, 1e-9);
-          improved = true;
-        } else {
-          lambda *= 10.0;
-        }
-      }
-      if (!improved || converged) break;
-    }
+    Problem problem(*this, obs, T_w_b, current, robustRound(round));
+    result.iterations += backend::minimize(problem, loop).trials;
     T_w_b.normalize();
     // The inliers of the next round, its cost and normal equations at the round's pose in one pass; after
     // the last round (or too few inliers) a plain pass: the result's cost and information.

@@ -3,6 +3,9 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
+
+#include "mcslam/backend/levenberg_marquardt.hpp"
 
 namespace mcslam::relative_pose_detail {
 
@@ -89,6 +92,66 @@ RayPair consistentRays(const RayPair& m, const SE3& T) {
   return c;
 }
 
+// Levenberg-Marquardt with Huber loss over the masked matches; with a fixed scale, t moves on its sphere.
+class RelativePoseProblem final : public backend::LeastSquaresProblem {
+ public:
+  RelativePoseProblem(std::span<const RayPair> matches, std::span<const uint8_t> mask, SE3& T, bool central,
+                      double huber)
+      : matches_(matches), mask_(mask), T_(T), central_(central), dim_(central ? 5 : 6), k_(huber) {
+    c_ = relative_pose_detail::cost(matches_, mask_, T_, k_);
+  }
+  bool linearize() override {
+    B_ = tangentBasis(T_.t);
+    H_ = Eigen::MatrixXd::Zero(dim_, dim_);
+    g_ = Eigen::VectorXd::Zero(dim_);
+    for (size_t i = 0; i < matches_.size(); ++i) {
+      if (!mask_[i]) continue;
+      Row6 J6;
+      const double e = fullJacobian(matches_[i], T_, J6);
+      Eigen::RowVectorXd J(dim_);
+      if (central_) {
+        J << J6.leftCols<3>() * B_, J6.rightCols<3>();
+      } else {
+        J = J6;
+      }
+      const double w = huberWeight(e * e, k_);
+      H_.noalias() += w * J.transpose() * J;
+      g_.noalias() += w * J.transpose() * e;
+    }
+    return true;
+  }
+  double cost() const override { return c_; }
+  void buildDampedSystem(double mu) override { backend::dampedMatrix(H_, mu, A_); }
+  bool solveStep() override {
+    step_ = A_.ldlt().solve(-g_);
+    return step_.allFinite();
+  }
+  double stepNorm() const override { return step_.norm(); }
+  double modelCostDecrease(double) const override { return -(g_.dot(step_) + 0.5 * step_.dot(H_ * step_)); }
+  bool evaluateTrial(double& cost) override {
+    candidate_ = applyStep(T_, step_, central_, B_);
+    cost = trial_cost_ = relative_pose_detail::cost(matches_, mask_, candidate_, k_);
+    return true;
+  }
+  void acceptTrial() override {
+    T_ = candidate_;
+    c_ = trial_cost_;
+  }
+
+ private:
+  std::span<const RayPair> matches_;
+  std::span<const uint8_t> mask_;
+  SE3& T_;
+  const bool central_;
+  const int dim_;
+  const double k_;
+  double c_ = 0, trial_cost_ = 0;
+  Eigen::Matrix<double, 3, 2> B_;
+  Eigen::MatrixXd H_, A_;
+  Eigen::VectorXd g_, step_;
+  SE3 candidate_;
+};
+
 }  // namespace
 
 double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J) {
@@ -117,51 +180,16 @@ double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1,
 
 SE3 refineRelativePose(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& start,
                        bool fixed_scale, const RelativePoseOptions& options) {
-  const bool central = fixed_scale;  // same parametrization
-  const int dim = central ? 5 : 6;
-  const double k = 2.0 * options.bearing_sigma_rad;
   SE3 T = start;
   if (!(T.t.norm() > 0)) return T;
-  double c = cost(matches, mask, T, k);
-  double lambda = 1e-4;
-  for (int it = 0; it < 100; ++it) {
-    const Eigen::Matrix<double, 3, 2> B = tangentBasis(T.t);
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(dim);
-    for (size_t i = 0; i < matches.size(); ++i) {
-      if (!mask[i]) continue;
-      Row6 J6;
-      const double e = fullJacobian(matches[i], T, J6);
-      Eigen::RowVectorXd J(dim);
-      if (central) {
-        J << J6.leftCols<3>() * B, J6.rightCols<3>();
-      } else {
-        J = J6;
-      }
-      const double w = huberWeight(e * e, k);
-      H.noalias() += w * J.transpose() * J;
-      g.noalias() += w * J.transpose() * e;
-    }
-    bool improved = false;
-    Eigen::VectorXd step;
-    while (lambda < 1e10) {
-      Eigen::MatrixXd A = H;
-      A.diagonal() += lambda * (H.diagonal().array() + 1e-12).matrix();
-      step = A.ldlt().solve(-g);
-      if (!step.allFinite()) break;
-      const SE3 candidate = applyStep(T, step, central, B);
-      const double cc = cost(matches, mask, candidate, k);
-      if (cc < c) {
-        T = candidate;
-        c = cc;
-        lambda = std::max(lambda * 0.2, 1e-9);
-        improved = true;
-        break;
-      }
-      lambda *= 10;
-    }
-    if (!improved || step.norm() < 1e-12) break;
-  }
+  RelativePoseProblem problem(matches, mask, T, fixed_scale, 2.0 * options.bearing_sigma_rad);
+  backend::LoopOptions loop;
+  loop.damping = backend::DampingPolicy::trustRegion(1e4);
+  loop.max_steps = 100;
+  loop.small_step = backend::LoopOptions::SmallStep::EndsOnceTaken;
+  loop.min_step_norm = 1e-12;
+  loop.stop_on_failed_solve = true;
+  backend::minimize(problem, loop);
   T.normalize();
   return T;
 }

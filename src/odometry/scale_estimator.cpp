@@ -6,6 +6,7 @@
 #include <bit>
 #include <limits>
 
+#include "mcslam/backend/levenberg_marquardt.hpp"
 #include "mcslam/backend/reprojection_residual.hpp"
 
 namespace mcslam {
@@ -15,9 +16,8 @@ namespace {
 // that the cost stays continuous enough to search.
 constexpr double kMissingSigmas = 10.0;
 constexpr int kRefineSteps = 6;
-// Levenberg-Marquardt damping (relative to the system's diagonal): a step that does not lower the cost is
-// retried with ten times more, up to the largest (then the window is at its minimum).
-constexpr double kMinDamping = 1e-6, kMaxDamping = 1e4;
+constexpr double kInitialRadius = 1e6;
+constexpr int kMaxRefusals = 10;
 // The profile's spacing in s, and the steps that re-fit the window at each factor (from its neighbour's fit): the
 // profile only chooses the basin, the free refinement then finds the minimum in it.
 constexpr double kProfileRatio = 1.4;
@@ -26,7 +26,7 @@ constexpr int kProfileSteps = 2;
 
 ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
                                float octave_scale_factor, int levels)
-    : rig_(rig) {
+    : rig_(rig), schur_(kMaxKeyframes, kMaxLandmarkObservations) {
   kf_slot_of_.resize(max_keyframes);
   kf_order_.resize(max_keyframes);
   for (int o = 0; o < std::max(levels, 1); ++o) octave_sigma_.push_back(std::pow(octave_scale_factor, o));
@@ -107,37 +107,55 @@ void ScaleEstimator::restoreWindow(const std::vector<SE3>& kf, const std::vector
   std::copy_n(lm.begin(), nl_, lm_p_.begin());
 }
 
-bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
-  c = cost();
-  u_step = 0;
-  double lambda = kMinDamping;
-  ReducedVec step;
-  for (int it = 0; it < steps; ++it) {
+// Levenberg-Marquardt over the free keyframe poses; the landmarks follow (re-fitted in every cost and system).
+class ScaleEstimator::Problem final : public backend::LeastSquaresProblem {
+ public:
+  explicit Problem(ScaleEstimator& e) : e_(e), c_(e.cost()) {}
+  bool linearize() override {
     double chi2 = 0;
     int residuals = 0;
-    if (!reducedSystem(chi2, residuals)) return false;
-    std::copy_n(kf_T_.begin(), nk_, kf_before_.begin());
-    bool taken = false;
-    for (; !taken && lambda <= kMaxDamping; lambda *= 10.0) {
-      if (!dampedStep(lambda, step)) continue;
-      for (int w = 0; w < nk_; ++w) {
-        const int f = freeIndex(w);
-        if (f >= 0) kf_T_[w] = kf_before_[w] * SE3::exp(step.segment<6>(6 * f));
-      }
-      const double trial = cost();
-      if (trial < c) {
-        c = trial;
-        u_step = g_.dot(step);
-        taken = true;
-      }
-    }
-    if (!taken) {  // no descent even along the gradient: the minimum
-      std::copy_n(kf_before_.begin(), nk_, kf_T_.begin());
-      break;
-    }
-    lambda = std::max(kMinDamping, lambda / 100.0);  // the loop's last *10 included
+    if (!e_.reducedSystem(chi2, residuals)) return false;
+    std::copy_n(e_.kf_T_.begin(), e_.nk_, e_.kf_before_.begin());
+    return true;
   }
-  return true;
+  double cost() const override { return c_; }
+  void buildDampedSystem(double mu) override { mu_ = mu; }
+  bool solveStep() override { return e_.dampedStep(mu_, step_); }
+  double stepNorm() const override { return step_.norm(); }
+  double modelCostDecrease(double) const override { return -(e_.b_.dot(step_) + 0.5 * step_.dot(e_.S_ * step_)); }
+  bool evaluateTrial(double& cost) override {
+    for (int w = 0; w < e_.nk_; ++w) {
+      const int f = e_.freeIndex(w);
+      if (f >= 0) e_.kf_T_[w] = e_.kf_before_[w] * SE3::exp(step_.segment<6>(6 * f));
+    }
+    cost = trial_ = e_.cost();
+    return true;
+  }
+  void acceptTrial() override {
+    c_ = trial_;
+    u_step_ = e_.g_.dot(step_);
+  }
+  void rejectTrial() override { std::copy_n(e_.kf_before_.begin(), e_.nk_, e_.kf_T_.begin()); }
+  double uStep() const { return u_step_; }
+
+ private:
+  ScaleEstimator& e_;
+  double c_, trial_ = 0, mu_ = 0, u_step_ = 0;
+  ReducedVec step_;
+};
+
+bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
+  // The trust region from mu = 1e-6; ten refusals in a row (each re-fits every landmark) end it: the window is at
+  // its minimum.
+  backend::LoopOptions loop;
+  loop.damping = backend::DampingPolicy::trustRegion(kInitialRadius);
+  loop.max_steps = steps;
+  loop.max_consecutive_rejections = kMaxRefusals;
+  Problem problem(*this);
+  const backend::LoopSummary summary = backend::minimize(problem, loop);
+  c = problem.cost();
+  u_step = problem.uStep();
+  return !summary.failed;
 }
 
 double ScaleEstimator::scaleOfPoses() const {
@@ -152,8 +170,6 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
   b_.setZero(dim);
   chi2 = 0;
   residuals = 0;
-  Eigen::Matrix<double, 6, 3> W[kMaxLandmarkObservations];
-  int wf[kMaxLandmarkObservations];
   SE3 T_b_w[kMaxKeyframes];
   for (int w = 0; w < nk_; ++w) T_b_w[w] = kf_T_[w].inverse();
   for (int l = 0; l < nl_; ++l) {
@@ -162,7 +178,7 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
     lm_p_[l] = p;
     Mat3 Hll = Mat3::Zero();
     Vec3 bl = Vec3::Zero();
-    int m = 0;
+    schur_.beginPoint();
     for (int i = lm_first_[l]; i < lm_first_[l + 1]; ++i) {
       const Obs& o = obs_[i];
       Vec2 r;
@@ -178,20 +194,15 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
       Hll.noalias() += wt * J.point.transpose() * J.point;
       bl.noalias() += wt * J.point.transpose() * r;
       const int f = freeIndex(o.kf);
-      if (f < 0 || m >= kMaxLandmarkObservations) continue;
+      if (f < 0 || schur_.full()) continue;
       S_.block<6, 6>(6 * f, 6 * f).noalias() += wt * J.pose.transpose() * J.pose;
       b_.segment<6>(6 * f).noalias() += wt * J.pose.transpose() * r;
-      W[m] = wt * J.pose.transpose() * J.point;
-      wf[m++] = f;
+      schur_.appendCoupling(f) = wt * J.pose.transpose() * J.point;
     }
     Hll.diagonal().array() += 1e-9;
     const Mat3 Hinv = Hll.inverse();
     if (!Hinv.allFinite()) continue;
-    for (int a = 0; a < m; ++a) {
-      const Eigen::Matrix<double, 6, 3> WH = W[a] * Hinv;
-      b_.segment<6>(6 * wf[a]).noalias() -= WH * bl;
-      for (int c = 0; c < m; ++c) S_.block<6, 6>(6 * wf[a], 6 * wf[c]).noalias() -= WH * W[c].transpose();
-    }
+    schur_.eliminate(Hinv, bl, S_, b_);
   }
   // Scale gradient: u = log(sum of |t_i - t_oldest|), right perturbation moves t_i by R_i rho.
   const double sum = scaleOfPoses();
@@ -203,8 +214,7 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
     if (f >= 0 && d.norm() > 0) g_.segment<3>(6 * f) = kf_T_[w].R.transpose() * d / (d.norm() * sum);
   }
   // The variance of u (in units of the pixel sigmas) from the undamped system. The damping of dampedStep() only
-  // steadies the step: where the window does not constrain the scale it would pose as information (measured: a straight
-  // synthetic window's sigma 5360% became 21%; a window of the rendered 10 cm rig 93% became 3.8%).
+  // steadies the step: where the window does not constrain the scale it would pose as information.
   const Eigen::LDLT<Reduced> exact(S_);
   scale_variance_ = exact.info() == Eigen::Success ? g_.dot(exact.solve(g_)) : INFINITY;
   if (!(scale_variance_ > 0)) scale_variance_ = INFINITY;  // singular or indefinite: the scale is not observed
@@ -216,21 +226,20 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
   return b_.allFinite() && std::isfinite(scale_variance_);
 }
 
-bool ScaleEstimator::dampedStep(double lambda, ReducedVec& step) {
-  damped_ = S_;
-  damped_.diagonal().array() += 1e-9 + lambda * S_.diagonal().array();
+bool ScaleEstimator::dampedStep(double mu, ReducedVec& step) {
+  backend::dampedMatrix(S_, mu, damped_);
   const Eigen::LDLT<Reduced> ldlt(damped_);
   if (ldlt.info() != Eigen::Success) return false;
   step = ldlt.solve(-b_);
   return step.allFinite();
 }
 
-ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
-  ScaleEstimate out;
+// The window: the map's newest live keyframes (up to kMaxKeyframes), the back-end's and the older ones kept for
+// tracking: a window that spans a whole turn sees the lever arms move most. The oldest is the centre, held.
+// False when there are too few (or the map is not the one the estimator was sized for).
+bool ScaleEstimator::selectWindow(const Map& map, ScaleEstimate& out) {
   for (int c = 0; c < rig_.size(); ++c) T_c_b_[c] = rig_.T_b_c(c).inverse();
-  // The window: the map's newest live keyframes (up to kMaxKeyframes), the back-end's and the older ones kept for
-  // tracking: a window that spans a whole turn sees the lever arms move most. The oldest is the centre, held.
-  if (map.keyframeCapacity() > static_cast<int>(kf_slot_of_.size())) return out;  // not the map it was sized for
+  if (map.keyframeCapacity() > static_cast<int>(kf_slot_of_.size())) return false;  // not the map it was sized for
   std::fill(kf_slot_of_.begin(), kf_slot_of_.end(), -1);
   int live = 0;
   for (int i = 0; i < map.keyframeCapacity(); ++i) {
@@ -238,7 +247,7 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   }
   nk_ = std::min(live, kMaxKeyframes);
   out.keyframes = nk_;
-  if (nk_ < 3) return out;
+  if (nk_ < 3) return false;
   auto newer = [&](int a, int b) { return map.keyframe(a).id > map.keyframe(b).id; };
   std::nth_element(kf_order_.begin(), kf_order_.begin() + (nk_ - 1), kf_order_.begin() + live, newer);
   int oldest = kf_order_[0], newest = kf_order_[0];
@@ -256,10 +265,14 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
     kf_T_[w] = map.keyframe(kf_order_[w]).T_w_b;
     kf_T_[w].t -= out.center;
   }
-  // Landmarks seen from at least three window keyframes, with their window observations. A landmark of two
-  // keyframes was created by an epipolar search at the map's poses: its two rays were chosen because they meet
-  // there, so it agrees with the map's unit whether or not it is a lookalike (a quarter of the 10 cm rig's window
-  // landmarks were, audited against rendered depth). A third keyframe's observation is a test it could fail.
+  return true;
+}
+
+// Landmarks seen from at least three window keyframes, with their window observations. A landmark of two
+// keyframes was created by an epipolar search at the map's poses: its two rays were chosen because they meet
+// there, so it agrees with the map's unit whether or not it is a lookalike. A third keyframe's observation is a
+// test it could fail.
+void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
   nl_ = 0;
   no_ = 0;
   for (int lm = 0; lm < map.landmarkCapacity() && nl_ < static_cast<int>(lm_p_.size()); ++lm) {
@@ -282,44 +295,55 @@ ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
       const int octave = std::clamp<int>(kp.octave, 0, static_cast<int>(octave_sigma_.size()) - 1);
       obs_[no_++] = Obs{static_cast<int16_t>(w), L.obs[j].cam, Vec2(kp.x, kp.y), 1.0 / octave_sigma_[octave]};
     }
-    lm_p_[nl_] = L.p_w - out.center;
+    lm_p_[nl_] = L.p_w - center;
     ++nl_;
   }
   lm_first_[nl_] = no_;
+}
+
+// The profile of the cost over log s in [-log max_ratio, log max_ratio], from the map's unit outwards both ways;
+// each factor starts from its neighbour's re-fitted window, scaled. Leaves the window at the best factor; false
+// when the best is at the end of the range (no minimum inside: the window says nothing).
+bool ScaleEstimator::profileScale(double max_ratio) {
+  const double umax = std::log(max_ratio);
+  const int steps = std::max(2, static_cast<int>(std::ceil(umax / std::log(kProfileRatio))));
+  const double du = umax / steps;
+  saveWindow(kf_start_, lm_start_);
+  hold_scale_ = true;
+  int best = 0;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (const int dir : {1, -1}) {
+    restoreWindow(kf_start_, lm_start_);
+    for (int k = dir > 0 ? 0 : 1; k <= steps; ++k) {
+      if (k > 0) scaleWindow(std::exp(dir * du));
+      held_u_ = std::log(scaleOfPoses());
+      double c = 0, u_step = 0;
+      if (!refine(kProfileSteps, c, u_step)) break;
+      if (c < best_cost) {
+        best_cost = c;
+        best = dir * k;
+        saveWindow(kf_best_, lm_best_);
+      }
+    }
+  }
+  hold_scale_ = false;
+  if (best == -steps || best == steps) return false;  // no minimum inside the range: the window says nothing
+  restoreWindow(kf_best_, lm_best_);
+  return true;
+}
+
+ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
+  ScaleEstimate out;
+  if (!selectWindow(map, out)) return out;
+  collectLandmarks(map, out.center);
   out.landmarks = nl_;
   out.observations = no_;
   if (nl_ < 20) return out;
   const double scale_before = scaleOfPoses();
   if (!(scale_before > 0)) return out;
 
-  // 1. Coarse (max_ratio > 1): the profile of the cost over log s, from the map's unit outwards both ways; each
-  //    factor starts from its neighbour's re-fitted window, scaled.
-  if (max_ratio > 1.0) {
-    const double umax = std::log(max_ratio);
-    const int steps = std::max(2, static_cast<int>(std::ceil(umax / std::log(kProfileRatio))));
-    const double du = umax / steps;
-    saveWindow(kf_start_, lm_start_);
-    hold_scale_ = true;
-    int best = 0;
-    double best_cost = std::numeric_limits<double>::infinity();
-    for (const int dir : {1, -1}) {
-      restoreWindow(kf_start_, lm_start_);
-      for (int k = dir > 0 ? 0 : 1; k <= steps; ++k) {
-        if (k > 0) scaleWindow(std::exp(dir * du));
-        held_u_ = std::log(scaleOfPoses());
-        double c = 0, u_step = 0;
-        if (!refine(kProfileSteps, c, u_step)) break;
-        if (c < best_cost) {
-          best_cost = c;
-          best = dir * k;
-          saveWindow(kf_best_, lm_best_);
-        }
-      }
-    }
-    hold_scale_ = false;
-    if (best == -steps || best == steps) return out;  // no minimum inside the range: the window says nothing
-    restoreWindow(kf_best_, lm_best_);
-  }
+  // 1. Coarse (max_ratio > 1): the profile brings a map whose unit is far off into the basin.
+  if (max_ratio > 1.0 && !profileScale(max_ratio)) return out;
 
   // 2. Fine: Levenberg-Marquardt on the whole window, the scale free; the last system gives the marginal sigma.
   double c = 0, last_u_step = 0, chi2 = 0;
@@ -353,7 +377,7 @@ bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t
   if (info() > 0 && (log_scale - x) * (log_scale - x) > 9.0 * (sigma * sigma + 1.0 / info())) {
     // One window off by 3 sigma is an outlier; several in a row mean the map's scale moved. Once converged,
     // they must include two that share no keyframe: overlapping windows in a map a fast corner broke agree with
-    // each other (three at 0.79 +- 4% restarted the combination the wrong way: the map had shrunk).
+    // each other.
     if (rejected_++ == 0) first_rejected_newest_ = newest_id;
     const bool independent = drift_variance_ == 0 || oldest_id > first_rejected_newest_;
     if (rejected_ < kRestartAfter || !independent) return false;
@@ -368,10 +392,10 @@ bool ScaleFilter::add(double log_scale, double sigma, int64_t oldest_id, int64_t
   }
   if (drift_variance_ > 0 && committed_.info > 0 && sigma * sigma * committed_.info < 1.0) {
     // The unit does not only random-walk: it jumps where the scene leaves the rig one camera looking ahead (side
-    // cameras before blank walls, rendered 10 cm rig: 20% in 20 frames, 4 sigma of the drift). A window more
+    // cameras before blank walls). A window more
     // certain than the committed part that disagrees with it by more than both sigmas allow raises the committed
     // variance to what the disagreement shows (covariance matching). Only then: a turn's first windows, less
-    // certain, often disagree with both (one at 0.65 +- 15% rescaled by 0.68 a map that was within 2%).
+    // certain, often disagree with both.
     const double nu = log_scale - committed_.x, excess = nu * nu - sigma * sigma;
     if (excess * committed_.info > 1.0) committed_.info = 1.0 / excess;
   }

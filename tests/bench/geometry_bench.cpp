@@ -175,15 +175,17 @@ SE3 perturbedStart(const SE3& truth) {
 void PoseRefinementMcslam(benchmark::State& state) {
   PoseRefiner refiner(benchRig(), kCorrespondences);
   int f = 0;
-  double rotation_error = 0;
+  double rotation_error = 0, trials = 0;
   for (auto _ : state) {
     const PoseScene& frame = ransacFrames()[f];
     const PoseRefinementResult res = refiner.refine(frame.observations, perturbedStart(frame.T_w_b));
     benchmark::DoNotOptimize(res.T_w_b);
     rotation_error += rotationErrorDeg(res.T_w_b, frame.T_w_b);
+    trials += res.iterations;
     f = (f + 1) % kFrames;
   }
   state.counters["rot_err_deg"] = rotation_error / static_cast<double>(state.iterations());
+  state.counters["lm_trials"] = trials / static_cast<double>(state.iterations());
 }
 
 void PoseRefinementOpenGv(benchmark::State& state) {

@@ -68,6 +68,7 @@ class PoseRefiner {
     Vec6 g = Vec6::Zero();
     int inliers = 0;  // counted when the pass reclassifies
   };
+  class Problem;  // the Levenberg-Marquardt problem of one round
   Pass evaluate(std::span<const PoseObservation> obs, const SE3& T_b_w, bool robust, bool reclassify, bool linearize);
 
   RigProjector rig_;

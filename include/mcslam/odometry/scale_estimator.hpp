@@ -9,11 +9,10 @@
 //     oldest) and the landmarks are multiplied by it and the window is re-fitted with u held there. Scaling
 //     alone, poses otherwise held, favours the map's own unit: tracking and the back-end fitted the poses in
 //     that unit, absorbing what the lever arms disagree with, so every other unit costs more until the poses
-//     are re-fitted (measured on a synthetic small room: the scaled scan's minimum at the map's unit, the
-//     profile's at 0.43 for a truth of 0.40). The profile brings a map whose unit is far off into the basin;
+//     are re-fitted. The profile brings a map whose unit is far off into the basin;
 //  2. fine: Levenberg-Marquardt on the whole window (poses and landmarks, landmarks eliminated by the Schur
-//     complement) from there, only steps that lower the cost taken (plain Gauss-Newton once jumped into a
-//     state whose sigma was 0.05% and whose scale was 50% off). The scale is u = log of the summed keyframe
+//     complement) from there, only steps that lower the cost taken (undamped Gauss-Newton can jump into a
+//     state that looks certain and is far off). The scale is u = log of the summed keyframe
 //     distances from the oldest one; its sigma is the MARGINAL one (g^T S^-1 g over the reduced pose system),
 //     inflated by the reduced chi-square: holding the poses would give a sigma many times too small, as the
 //     poses absorb much of a scale error.
@@ -25,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "mcslam/backend/robust_loss.hpp"
+#include "mcslam/backend/schur_accumulator.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/rig_state.hpp"
 
@@ -70,6 +70,10 @@ class ScaleEstimator {
     Vec2 uv;
     double inv_sigma;
   };
+  class Problem;  // the Levenberg-Marquardt problem of refine()
+  bool selectWindow(const Map& map, ScaleEstimate& out);    // keyframes: kf_T_, oldest_, out's window fields
+  void collectLandmarks(const Map& map, const Vec3& center);  // lm_p_, lm_first_, obs_
+  bool profileScale(double max_ratio);                         // the coarse search
   double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
   // Robust cost of landmark l at p, keyframes at kf_T_; p is refined first (two Gauss-Newton steps).
   double landmarkCost(int l, Vec3& p);
@@ -83,7 +87,7 @@ class ScaleEstimator {
   // The reduced (Schur-complemented) system of the window at kf_T_ / lm_p_ (landmarks re-triangulated first),
   // and the variance of u it implies. False when not finite.
   bool reducedSystem(double& chi2, int& residuals);
-  bool dampedStep(double lambda, ReducedVec& step);  // solves (S + lambda diag S) step = -b
+  bool dampedStep(double mu, ReducedVec& step);  // solves (S + mu D) step = -b (backend::dampedMatrix)
   double scaleOfPoses() const;  // summed distances of the keyframes from the oldest (the centre)
   // Block of window keyframe w in the reduced pose system (-1: the oldest, held).
   int freeIndex(int w) const { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); }
@@ -98,6 +102,7 @@ class ScaleEstimator {
   std::vector<SE3> kf_start_, kf_best_;  // the window as the map has it, and the profile's best fit
   std::vector<Vec3> lm_start_, lm_best_;
   int oldest_ = 0;              // window index of the oldest keyframe (held)
+  backend::SchurAccumulator schur_;  // eliminates the landmarks from the reduced pose system
   Reduced S_, damped_;
   ReducedVec b_, g_;
   double scale_variance_ = 0;  // g^T S^-1 g of the last reduced system
@@ -114,9 +119,9 @@ class ScaleEstimator {
 // The window estimates, combined into the map's log-scale error. Windows that share keyframes are not
 // independent, and of two that overlap in a turn the later usually holds more of it (its sigma falls from tens
 // of percent to a few as the turn enters the window): of overlapping windows only the most certain counts
-// (pending); it is fused with the earlier ones (committed) once a window sharing no keyframe with it arrives.
-// (Counting every window by its share of new keyframes instead would keep the windows before a turn, which saw
-// little of it, at the weight of the turn's own.) An estimate that disagrees with the combined one by more than 3 sigma
+// (pending); it is fused with the earlier ones (committed) once a window sharing no keyframe with it arrives
+// (counting every window by its share of new keyframes would weigh the windows before a turn, which saw little
+// of it, like the turn's own). An estimate that disagrees with the combined one by more than 3 sigma
 // is dropped; when several in a row disagree, the map's scale has drifted (a straight stretch hides it) and the
 // combination restarts from the latest. Windows of one turn also share their scene and the map's history:
 // rotationSpan() says over how much rotation of the rig (radians travelled, `rotation` of add()) the combined
