@@ -1,6 +1,25 @@
 #!/usr/bin/env bash
 # Sets up (packages + build) and runs the whole test suite through CTest.
+# Usage: tools/run-tests.sh [--ci]
+#   --ci   what CI runs (.ci/run): the build with -Werror, the suite, the formatter check (tools/check-format.sh)
+#          and the sanitizer jobs (tools/run-sanitizers.sh: ASan+UBSan over the suite, TSan over the threaded tests)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-tools/setup.sh
+ci=0
+case "${1:-}" in
+  "") ;;
+  --ci) ci=1 ;;
+  -h|--help) sed -n '2,5p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  *) echo "run-tests: unknown option '$1' (see --help)" >&2; exit 2 ;;
+esac
+
+if ((ci)); then
+  MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" tools/setup.sh
+else
+  tools/setup.sh
+fi
 ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
+if ((ci)); then
+  tools/check-format.sh
+  tools/run-sanitizers.sh all
+fi

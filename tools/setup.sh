@@ -9,7 +9,7 @@ packages=(
   libeigen3-dev libopencv-dev libopengv-dev libsuitesparse-dev libspdlog-dev libyaml-cpp-dev libcli11-dev
   libaravis-dev aravis-tools libusb-1.0-0-dev libgpiod-dev
   libgtest-dev libgmock-dev libbenchmark-dev libceres-dev
-  systemd
+  systemd ccache
 )
 missing=()
 for p in "${packages[@]}"; do
@@ -24,6 +24,11 @@ if ((${#missing[@]})); then
 fi
 
 jobs="$(nproc)"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+# ccache (when installed) makes rebuilds after a checkout or a clean cheap.
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+# MCSLAM_CMAKE_ARGS: extra CMake arguments (tools/run-tests.sh --ci passes -DMCSLAM_WERROR=ON).
+# shellcheck disable=SC2086
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" ${MCSLAM_CMAKE_ARGS:-}
 cmake --build build -j"$jobs"
 echo "setup: built; executables are in build/bin"

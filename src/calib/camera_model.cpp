@@ -66,10 +66,11 @@ void CameraModel::computeValidDomain() {
     // Beyond the image the polynomial was never calibrated and grows wildly: keep the domain to twice
     // the radius the image corners reach.
     double corner_r2 = 0;
-    for (const Vec2& c : {Vec2(-0.5, -0.5), Vec2(width_ - 0.5, -0.5), Vec2(-0.5, height_ - 0.5),
-                         Vec2(width_ - 0.5, height_ - 0.5)}) {
-      Vec3 b;
-      if (unproject(c, b) && b.z() > 0) corner_r2 = std::max(corner_r2, b.head<2>().squaredNorm() / (b.z() * b.z()));
+    for (const Vec2& corner : {Vec2(-0.5, -0.5), Vec2(width_ - 0.5, -0.5), Vec2(-0.5, height_ - 0.5),
+                              Vec2(width_ - 0.5, height_ - 0.5)}) {
+      Vec3 ray;
+      if (unproject(corner, ray) && ray.z() > 0)
+        corner_r2 = std::max(corner_r2, ray.head<2>().squaredNorm() / (ray.z() * ray.z()));
     }
     if (corner_r2 > 0) max_radius2_ = std::min(max_radius2_, 4.0 * corner_r2);
   }

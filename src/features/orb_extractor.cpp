@@ -171,8 +171,8 @@ int OrbExtractor::Impl::extractLevel(int level, const Plane& image, int budget, 
     Keypoint& kp = out.keypoints[static_cast<size_t>(out.count)];
     kp.angle = intensityCentroidAngle(image.data + offset, image.stride);
     // Level pixel centres map to level 0 as the pyramid's resampling does.
-    kp.x = (c.x + 0.5f) * scale - 0.5f;
-    kp.y = (c.y + 0.5f) * scale - 0.5f;
+    kp.x = (static_cast<float>(c.x) + 0.5f) * scale - 0.5f;
+    kp.y = (static_cast<float>(c.y) + 0.5f) * scale - 0.5f;
     kp.response = c.score;
     kp.octave = static_cast<int8_t>(level);
     steeredBrief(smooth.data + offset, pattern.forAngle(kp.angle), out.descriptors[static_cast<size_t>(out.count)]);

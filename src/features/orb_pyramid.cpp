@@ -54,17 +54,17 @@ void resampleRow(const int16_t* row, const DownscaleScratch& scratch, int width,
 void downscale(const ConstPlane& src, const Plane& dst, float ratio, const DownscaleScratch& scratch, bool use_simd) {
   const int last_x = src.width - 1, last_y = src.height - 1;
   for (int x = 0; x < dst.width; ++x) {
-    const float sx = std::clamp((x + 0.5f) * ratio - 0.5f, 0.0f, static_cast<float>(last_x));
+    const float sx = std::clamp((static_cast<float>(x) + 0.5f) * ratio - 0.5f, 0.0f, static_cast<float>(last_x));
     const int x0 = std::min(static_cast<int>(sx), std::max(last_x - 1, 0));
-    const uint32_t f = static_cast<uint32_t>(std::lround((sx - x0) * 256.0f));
+    const uint32_t f = static_cast<uint32_t>(std::lround((sx - static_cast<float>(x0)) * 256.0f));
     scratch.src_x[x] = x0;
     scratch.weights[x] = (256u - f) | (f << 16);
   }
   int16_t* row = scratch.row;
   for (int y = 0; y < dst.height; ++y) {
-    const float sy = std::clamp((y + 0.5f) * ratio - 0.5f, 0.0f, static_cast<float>(last_y));
+    const float sy = std::clamp((static_cast<float>(y) + 0.5f) * ratio - 0.5f, 0.0f, static_cast<float>(last_y));
     const int y0 = std::min(static_cast<int>(sy), std::max(last_y - 1, 0));
-    const uint16_t fy = static_cast<uint16_t>(std::lround((sy - y0) * 256.0f));
+    const uint16_t fy = static_cast<uint16_t>(std::lround((sy - static_cast<float>(y0)) * 256.0f));
     const uint16_t gy = static_cast<uint16_t>(256 - fy);
     const uint8_t* a = src.row(y0);
     const uint8_t* b = src.row(std::min(y0 + 1, last_y));

@@ -157,7 +157,7 @@ int PairMatcher::matchCameras(const Rig& rig, const FrameFeatures& f, int i, int
   int kept = 0;
   for (int m = 0; m < count; ++m) {
     const int b = out[m].kp_b;
-    if (sc.best_for_b[b] == out[m].kp_a && sc.best_dist_for_b[b] < options_.ratio * sc.second_dist_for_b[b]) {
+    if (sc.best_for_b[b] == out[m].kp_a && passesRatioTest(sc.best_dist_for_b[b], sc.second_dist_for_b[b], options_.ratio)) {
       out[kept++] = out[m];
     }
   }
@@ -302,7 +302,7 @@ int PairMatcher::bestOfCandidates(const FrameFeatures& f, int i, int j, int a, i
     const double dx = kc.x - kb.x, dy = kc.y - kb.y;
     if (sc.candidate_dist[c] < second && dx * dx + dy * dy > same2) second = sc.candidate_dist[c];
   }
-  if (!(best < options_.ratio * second)) return -1;
+  if (!passesRatioTest(best, second, options_.ratio)) return -1;
   return best_c;
 }
 

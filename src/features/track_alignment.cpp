@@ -95,7 +95,7 @@ void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, 
       continue;
     }
     any = any || status == AlignmentStatus::Ok;
-    track_aligned_[t] += status == AlignmentStatus::Ok ? 1 : 0;
+    if (status == AlignmentStatus::Ok) ++track_aligned_[t];
     ++s;
   }
   if (any) {

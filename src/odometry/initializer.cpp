@@ -55,7 +55,7 @@ int Initializer::matchToReference(const FrameFeatures& f) {
           second = d;
         }
       }
-      if (best_r < 0 || best > kMaxHamming || !(best < kRatio * second) || best_of_ref_[best_r] != k) continue;
+      if (best_r < 0 || best > kMaxHamming || !passesRatioTest(best, second, kRatio) || best_of_ref_[best_r] != k) continue;
       if (!reference_.valid[c][best_r]) continue;
       RelativeCorrespondence m;
       m.camera1 = c;

@@ -106,7 +106,7 @@ int ProjectionSearch::search(const Map& map, const Rig& rig, const int32_t* slot
         }
       });
       if (best_kp < 0 || best > p.max_hamming) continue;
-      if (best_octave == second_octave && !(best < p.ratio * second)) continue;
+      if (best_octave == second_octave && !passesRatioTest(best, second, p.ratio)) continue;
       if (matches.offer(c, best_kp, lm, best)) ++made;
     }
     if (visible && count_visible) ++count_visible->of(map, lm).visible;
@@ -144,7 +144,7 @@ int ProjectionSearch::searchByDescriptor(const Map& map, const int32_t* slots, i
         }
       }
     }
-    if (best_kp < 0 || best > max_hamming || !(best < ratio * second)) continue;
+    if (best_kp < 0 || best > max_hamming || !passesRatioTest(best, second, ratio)) continue;
     if (matches.offer(best_cam, best_kp, lm, best)) ++made;
   }
   return made;

@@ -101,7 +101,7 @@ int TemporalTriangulator::matchKeyframes(const Rig& rig, const Keyframe& kn, con
     }
     for (int a = 0; a < set2.count; ++a) {
       const Best& best = best_[a];
-      if (best.kp < 0 || !best.free || best.distance > kMaxHamming || !(best.distance < kRatio * best.second)) {
+      if (best.kp < 0 || !best.free || best.distance > kMaxHamming || !passesRatioTest(best.distance, best.second, kRatio)) {
         continue;
       }
       // One candidate per old keypoint: the closest descriptor wins.

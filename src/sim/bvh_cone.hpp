@@ -20,8 +20,8 @@ void Bvh::cone(const std::vector<Prim>& prims, const float apex[3], const float 
     const BvhNode& n = nodes_[i];
     if (!sphereMeetsCone(apex, axis, cos_a, sin_a, spheres_[i].c, spheres_[i].r)) continue;
     if (n.count > 0) {
-      for (int i = 0; i < n.count; ++i) {
-        const int idx = order_[n.first + i];
+      for (int k = 0; k < n.count; ++k) {
+        const int idx = order_[n.first + k];
         const Prim& p = prims[idx];
         if (sphereMeetsCone(apex, axis, cos_a, sin_a, p.c, p.radius)) visit(idx);
       }

@@ -39,7 +39,7 @@ Prim Prim::cylinder(const SE3& T_w_o, double r, double half_height, uint32_t fac
 SE3 Prim::pose() const {
   Mat3 R_o_w;
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) R_o_w(r, c) = R[3 * r + c];
+    for (int k = 0; k < 3; ++k) R_o_w(r, k) = R[3 * r + k];
   }
   SE3 T(R_o_w.transpose(), Vec3(c[0], c[1], c[2]));
   T.normalize();

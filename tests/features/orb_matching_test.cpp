@@ -84,7 +84,7 @@ INSTANTIATE_TEST_SUITE_P(SyntheticPairs, OrbMatchingVsOpenCv,
                                            PairCase{"rotate40", 12, 0.70, 1.0, 0, 0},
                                            PairCase{"zoomout_tilt", 13, -0.1, 0.85, 2e-4, -1.5e-4},
                                            PairCase{"rotate90_scale1.3", 14, 1.5708, 1.3, 0, 0}),
-                         [](const auto& info) { return std::string("Case") + std::to_string(info.index); });
+                         [](const auto& param) { return std::string("Case") + std::to_string(param.index); });
 
 }  // namespace
 }  // namespace mcslam::test

@@ -42,7 +42,7 @@ void printInfoText(const Dataset& ds) {
                 distortionName(m.distortion()));
   }
   std::printf("rig frames: %zu (%zu with every camera), %.2f s, %.2f Hz; sync tolerance %.3f ms\n", ds.size(), s.complete,
-              s.duration_s, s.rate_hz, ds.syncToleranceNs() * 1e-6);
+              s.duration_s, s.rate_hz, static_cast<double>(ds.syncToleranceNs()) * 1e-6);
   if (ds.groundTruth()) {
     std::printf("ground truth: %zu poses, %.2f m of path (%s)\n", ds.groundTruth()->size(), pathLength(*ds.groundTruth()),
                 ds.groundTruthPath().c_str());

@@ -68,9 +68,9 @@ Summary summarize(std::vector<double> v) {
   if (v.empty()) return s;
   double sum = 0;
   for (double x : v) sum += x;
-  s.mean = sum / v.size();
+  s.mean = sum / static_cast<double>(v.size());
   std::sort(v.begin(), v.end());
-  s.p99 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.99 * (v.size() - 1) + 0.5))];
+  s.p99 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(v.size() - 1) + 0.5))];
   s.max = v.back();
   return s;
 }

@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "../shm_echo/pose_print.hpp"
+#include "pose_print.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-udp-echo: print the pose datagrams mcslamd sends"};

@@ -38,7 +38,7 @@ class LatencyHistogram {
   static constexpr double kMinNs = 1000.0;  // 1 us
   static constexpr double kStep = 1.02;
   static int binOf(int64_t ns) {
-    if (ns <= kMinNs) return 0;
+    if (static_cast<double>(ns) <= kMinNs) return 0;
     const int b = 1 + static_cast<int>(std::log(static_cast<double>(ns) / kMinNs) / std::log(kStep));
     return b >= kBins ? kBins - 1 : b;
   }

@@ -21,6 +21,11 @@ inline int hammingDistance(const Descriptor& a, const Descriptor& b) {
          std::popcount(a[3] ^ b[3]);
 }
 
+// Lowe's ratio test on Hamming distances: the best match is distinctly better than the second best.
+inline bool passesRatioTest(int best, int second, float ratio) {
+  return static_cast<float>(best) < ratio * static_cast<float>(second);
+}
+
 // The features of one image. Capacity is fixed at construction; `count` says how many are valid.
 struct FeatureSet {
   std::vector<Keypoint> keypoints;

@@ -62,8 +62,8 @@ class KeypointGrid {
 
  private:
   int cellOf(float x, float y) const {
-    const int cx = std::clamp(static_cast<int>(x / cell_), 0, cols_ - 1);
-    const int cy = std::clamp(static_cast<int>(y / cell_), 0, rows_ - 1);
+    const int cx = std::clamp(static_cast<int>(x / static_cast<float>(cell_)), 0, cols_ - 1);
+    const int cy = std::clamp(static_cast<int>(y / static_cast<float>(cell_)), 0, rows_ - 1);
     return cy * cols_ + cx;
   }
 

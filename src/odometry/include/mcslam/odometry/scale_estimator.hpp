@@ -1,6 +1,6 @@
 #pragma once
 // Metric scale of a map that a rig of non-overlapping cameras started up to scale. Two frames cannot fix it
-// with lever arms of centimetres (BENCHMARKS.md, "Why the non-overlapping rig fails"); a window of keyframes
+// with lever arms of centimetres (the relative pose is nearly degenerate in scale); a window of keyframes
 // that turns can: the cameras' centres then move differently from the body, and only one scale explains the
 // reprojections through the metric extrinsics.
 //
