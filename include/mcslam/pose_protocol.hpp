@@ -24,12 +24,12 @@ inline constexpr uint8_t kFlagKeyframe = 1u << 1;  // the pipeline made this fra
 inline constexpr uint8_t kFlagUnscaled = 1u << 2;
 
 struct PoseRecord {
-  uint64_t sequence = 0;        // publish counter, 1 for the first pose of a daemon run, +1 per pose
-  uint64_t frame_sequence = 0;  // trigger count / frame index of the rig frame (gaps = dropped frames)
-  int64_t capture_time_ns = 0;  // capture time, the time base of the trajectory file
-  int64_t publish_time_ns = 0;  // CLOCK_REALTIME when the daemon published the pose
-  double position[3] = {0, 0, 0};         // T_w_b translation, metres
-  double orientation[4] = {0, 0, 0, 1};   // T_w_b rotation, unit quaternion x, y, z, w
+  uint64_t sequence = 0;                 // publish counter, 1 for the first pose of a daemon run, +1 per pose
+  uint64_t frame_sequence = 0;           // trigger count / frame index of the rig frame (gaps = dropped frames)
+  int64_t capture_time_ns = 0;           // capture time, the time base of the trajectory file
+  int64_t publish_time_ns = 0;           // CLOCK_REALTIME when the daemon published the pose
+  double position[3] = {0, 0, 0};        // T_w_b translation, metres
+  double orientation[4] = {0, 0, 0, 1};  // T_w_b rotation, unit quaternion x, y, z, w
   Tracking tracking = Tracking::NotInitialized;
   uint8_t flags = 0;
   float quality = 0;  // 0..1
@@ -101,9 +101,9 @@ inline float getF32(const uint8_t* p) {
 
 // Byte offsets (docs/pose-protocol.md, table "pose record").
 namespace offset {
-inline constexpr std::size_t kMagic = 0, kVersion = 4, kSize = 6, kSequence = 8, kFrameSequence = 16,
-                             kCaptureTime = 24, kPublishTime = 32, kPosition = 40, kOrientation = 64,
-                             kTracking = 96, kFlags = 97, kReserved = 98, kQuality = 100;
+inline constexpr std::size_t kMagic = 0, kVersion = 4, kSize = 6, kSequence = 8, kFrameSequence = 16, kCaptureTime = 24,
+                             kPublishTime = 32, kPosition = 40, kOrientation = 64, kTracking = 96, kFlags = 97,
+                             kReserved = 98, kQuality = 100;
 }
 
 inline void encodePacket(const PoseRecord& r, uint8_t out[kPacketSize]) {

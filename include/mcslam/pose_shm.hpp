@@ -42,14 +42,14 @@ struct alignas(64) ShmSlot {
 struct alignas(64) ShmHeader {
   std::atomic<uint32_t> magic;  // stored last, with release, once the header is complete
   uint16_t version;
-  uint16_t header_size;          // 128: offset of the latest-pose slot
-  uint32_t record_size;          // 104
-  uint32_t slot_size;            // 128
-  uint32_t ring_capacity;        // N
-  std::atomic<uint32_t> state;   // kWriterRunning, kWriterStopped
-  uint64_t ring_offset;          // 256: offset of ring slot 0
+  uint16_t header_size;         // 128: offset of the latest-pose slot
+  uint32_t record_size;         // 104
+  uint32_t slot_size;           // 128
+  uint32_t ring_capacity;       // N
+  std::atomic<uint32_t> state;  // kWriterRunning, kWriterStopped
+  uint64_t ring_offset;         // 256: offset of ring slot 0
   int64_t writer_pid;
-  int64_t start_time_ns;         // CLOCK_REALTIME when the writer created the segment
+  int64_t start_time_ns;            // CLOCK_REALTIME when the writer created the segment
   std::atomic<uint64_t> published;  // sequence of the newest pose (0 = none yet)
   uint64_t reserved[9];
 };
@@ -118,7 +118,8 @@ class PoseShmReader {
     base_ = static_cast<const uint8_t*>(p);
     size_ = static_cast<std::size_t>(st.st_size);
     const ShmHeader& h = header();
-    if (h.magic.load(std::memory_order_acquire) != kShmMagic) return failClose(error, name + ": not an mcslam pose segment (magic)");
+    if (h.magic.load(std::memory_order_acquire) != kShmMagic)
+      return failClose(error, name + ": not an mcslam pose segment (magic)");
     if (h.version != kShmVersion) return failClose(error, name + ": unsupported version " + std::to_string(h.version));
     if (h.record_size != kPacketSize || h.slot_size != kShmSlotSize || h.header_size != kShmHeaderSize ||
         h.ring_offset != kShmHeaderSize + kShmSlotSize || shmSegmentSize(h.ring_capacity) > size_ ||

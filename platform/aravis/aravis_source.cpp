@@ -116,8 +116,10 @@ void AravisSource::open(Camera& cam) {
     warnIf(err, key, "frame rate");
   }
   if (arv_camera_is_gv_device(cam.camera)) {
-    if (config_.packet_size > 0) arv_camera_gv_set_packet_size(cam.camera, config_.packet_size, &err);
-    else arv_camera_gv_auto_packet_size(cam.camera, &err);
+    if (config_.packet_size > 0)
+      arv_camera_gv_set_packet_size(cam.camera, config_.packet_size, &err);
+    else
+      arv_camera_gv_auto_packet_size(cam.camera, &err);
     warnIf(err, key, "packet size");
   }
   cam.stream = arv_camera_create_stream(cam.camera, nullptr, nullptr, &err);

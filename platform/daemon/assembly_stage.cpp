@@ -10,7 +10,10 @@ namespace mcslam::platform {
 
 AssemblyStage::AssemblyStage(const std::vector<std::pair<int, int>>& sizes, const AssemblySettings& settings,
                              CameraRings& in, RigRing& out, const WarmUp& warm_up)
-    : settings_(settings), in_(in), out_(out), warm_up_(warm_up),
+    : settings_(settings),
+      in_(in),
+      out_(out),
+      warm_up_(warm_up),
       assembler_(sizes, settings.pending_rig_frames, settings.match_by, settings.tolerance_ns, settings.timeout_ns) {}
 
 void AssemblyStage::start() {

@@ -35,8 +35,11 @@ AssemblySettings assemblySettings(const DaemonConfig& c) {
 
 Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> processor,
                std::unique_ptr<FrameSource> source)
-    : config_(config), processor_(std::move(processor)), source_(source ? std::move(source) : createSource(config)),
-      sizes_(imageSizes(config.rig)), camera_rings_(sizes_, config.capacities.camera_ring_slots),
+    : config_(config),
+      processor_(std::move(processor)),
+      source_(source ? std::move(source) : createSource(config)),
+      sizes_(imageSizes(config.rig)),
+      camera_rings_(sizes_, config.capacities.camera_ring_slots),
       rig_ring_(config.capacities.rig_ring_slots, [this](RigFrame& f) { f.allocate(sizes_); }),
       pose_ring_(config.capacities.pose_ring_slots),
       trigger_(config.trigger, config.realtime.trigger_priority, *source_, config.file),
@@ -75,11 +78,15 @@ bool Daemon::stop(int64_t grace_ns) {
     clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
   }
   const bool processing_finished = processing_.finished();
-  if (processing_finished) processing_.join();
-  else processing_.detach();  // stuck inside the pipeline; we still save what was published
+  if (processing_finished)
+    processing_.join();
+  else
+    processing_.detach();  // stuck inside the pipeline; we still save what was published
   publishing_.stop();
-  if (processing_finished) writeRefinedExtrinsics();  // else the pipeline may still be inside process()
-  else if (!extrinsics_path_.empty()) spdlog::error("refined extrinsics not written: the pipeline did not stop");
+  if (processing_finished)
+    writeRefinedExtrinsics();  // else the pipeline may still be inside process()
+  else if (!extrinsics_path_.empty())
+    spdlog::error("refined extrinsics not written: the pipeline did not stop");
   return processing_finished;
 }
 
@@ -96,8 +103,10 @@ void Daemon::writeRefinedExtrinsics() {
   } catch (const std::exception& e) {
     error = e.what();
   }
-  if (extrinsics_written_) spdlog::info("refined extrinsics written to {}", extrinsics_path_);
-  else spdlog::error("output.extrinsics: {}", error);
+  if (extrinsics_written_)
+    spdlog::info("refined extrinsics written to {}", extrinsics_path_);
+  else
+    spdlog::error("output.extrinsics: {}", error);
 }
 
 // Approximate (the counters are read one after the other); stop() drains whatever is still in flight.

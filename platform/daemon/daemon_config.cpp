@@ -268,8 +268,9 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
   c.slam = root["slam"] ? root["slam"] : YAML::Node(YAML::NodeType::Map);
   c.rig = resolveRig(c, top);
   if (c.rig.size() > static_cast<int>(c.capacities.max_cameras))
-    top.child("capacities").fail("max_cameras", "is " + std::to_string(c.capacities.max_cameras) + " but the rig has " +
-                                                    std::to_string(c.rig.size()) + " cameras");
+    top.child("capacities")
+        .fail("max_cameras", "is " + std::to_string(c.capacities.max_cameras) + " but the rig has " +
+                                 std::to_string(c.rig.size()) + " cameras");
   validatePipelineConfig(c.slam, file, c.rig);
   return c;
 }
@@ -289,8 +290,6 @@ SourceContext sourceContext(const DaemonConfig& c) {
   return s;
 }
 
-DaemonConfig loadDaemonConfig(const std::string& path) {
-  return parseDaemonConfig(readTextFile(path), path);
-}
+DaemonConfig loadDaemonConfig(const std::string& path) { return parseDaemonConfig(readTextFile(path), path); }
 
 }  // namespace mcslam::platform

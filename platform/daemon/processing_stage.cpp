@@ -8,14 +8,22 @@ namespace mcslam::platform {
 
 ProcessingStage::ProcessingStage(FrameProcessor& processor, int cameras, int priority, uint64_t warmup_frames,
                                  RigRing& in, PoseRing& out, BackPressure& pressure, WarmUp& warm_up)
-    : runner_(processor), priority_(priority), warmup_frames_(warmup_frames), in_(in), out_(out), pressure_(pressure),
-      warm_up_(warm_up), views_(static_cast<std::size_t>(cameras)) {}
+    : runner_(processor),
+      priority_(priority),
+      warmup_frames_(warmup_frames),
+      in_(in),
+      out_(out),
+      pressure_(pressure),
+      warm_up_(warm_up),
+      views_(static_cast<std::size_t>(cameras)) {}
 
 void ProcessingStage::start() {
   processing_thread_ = std::thread([this] {
     setUpThread("mcslam-process", "processing");
-    if (runner_.canOverlap()) trackingLoop();
-    else wholeLoop();
+    if (runner_.canOverlap())
+      trackingLoop();
+    else
+      wholeLoop();
     done_.store(true, std::memory_order_release);
   });
   if (runner_.canOverlap()) {

@@ -6,8 +6,11 @@ namespace mcslam::platform {
 
 RigAssembler::RigAssembler(const std::vector<std::pair<int, int>>& sizes, uint32_t pending, MatchBy match_by,
                            int64_t tolerance_ns, int64_t timeout_ns)
-    : cameras_(static_cast<int>(sizes.size())), match_by_(match_by), tolerance_ns_(tolerance_ns),
-      timeout_ns_(timeout_ns), pending_(pending) {
+    : cameras_(static_cast<int>(sizes.size())),
+      match_by_(match_by),
+      tolerance_ns_(tolerance_ns),
+      timeout_ns_(timeout_ns),
+      pending_(pending) {
   for (auto& p : pending_) p.frame.allocate(sizes);
 }
 
@@ -29,7 +32,7 @@ RigAssembler::Pending* RigAssembler::oldest() {
   for (auto& p : pending_) {
     if (!p.used) continue;
     const bool older = !best || (match_by_ == MatchBy::TriggerCount ? p.frame.sequence < best->frame.sequence
-                                                                      : p.frame.capture_ns < best->frame.capture_ns);
+                                                                    : p.frame.capture_ns < best->frame.capture_ns);
     if (older) best = &p;
   }
   return best;

@@ -16,9 +16,9 @@
 namespace mcslam::platform {
 
 void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char* out, std::size_t size) {
-  const double per_frame = s.frames_after_warmup
-                               ? static_cast<double>(s.allocations_after_warmup) / static_cast<double>(s.frames_after_warmup)
-                               : 0.0;
+  const double per_frame = s.frames_after_warmup ? static_cast<double>(s.allocations_after_warmup) /
+                                                       static_cast<double>(s.frames_after_warmup)
+                                                 : 0.0;
   std::snprintf(out, size,
                 "%.1f Hz, %s%s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
                 "cameras %s%s",
@@ -35,7 +35,8 @@ namespace {
 class Watch {
  public:
   explicit Watch(double status_interval_s)
-      : status_ns_(static_cast<int64_t>(status_interval_s * 1e9)), last_progress_(monotonicNowNs()),
+      : status_ns_(static_cast<int64_t>(status_interval_s * 1e9)),
+        last_progress_(monotonicNowNs()),
         last_status_(last_progress_) {}
 
   // One tick: the watchdog (only when frames were processed since the last tick, or a finished replay idles),
@@ -76,8 +77,10 @@ class Watch {
 
   void logChanges(const DaemonStats& s, const char* health) {
     if (s.tracking != last_state_) {
-      if (s.tracking == TrackingState::Lost) spdlog::warn("tracking lost (frame {})", s.processed);
-      else spdlog::info("tracking state: {}{}", trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "");
+      if (s.tracking == TrackingState::Lost)
+        spdlog::warn("tracking lost (frame {})", s.processed);
+      else
+        spdlog::info("tracking state: {}{}", trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "");
       last_state_ = s.tracking;
     } else if (last_unscaled_ && !s.unscaled && s.tracking == TrackingState::Tracking) {
       spdlog::info("metric scale found (by frame {}): positions are in metres from here on", s.processed);

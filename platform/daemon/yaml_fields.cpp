@@ -129,8 +129,7 @@ unsigned YamlFields::permissions(const char* key, unsigned fallback) const {
   const std::string s = string(key, "");
   char* end = nullptr;
   const unsigned long v = std::strtoul(s.c_str(), &end, 8);
-  if (s.empty() || *end != '\0' || v > 0777)
-    fail(key, "expected octal permissions such as \"0640\", got '" + s + "'");
+  if (s.empty() || *end != '\0' || v > 0777) fail(key, "expected octal permissions such as \"0640\", got '" + s + "'");
   return static_cast<unsigned>(v);
 }
 

@@ -25,7 +25,8 @@ void copyImage(const Image& from, Image& to) {
 }  // namespace
 
 DatasetSource::DatasetSource(const DatasetSourceConfig& config, const SourceContext& context)
-    : cfg_(config), software_(context.trigger.mode == TriggerMode::Software),
+    : cfg_(config),
+      software_(context.trigger.mode == TriggerMode::Software),
       dataset_(Dataset::open(config.path, optionsOf(config, context))) {
   const std::string key = context.file + ": source.dataset";
   if (dataset_.size() == 0) throw InputError(key + ".path: '" + cfg_.path + "' has no frames");
@@ -117,8 +118,8 @@ void DatasetSource::emit(std::size_t i, uint64_t loop, uint64_t trigger_index, i
     const Image& image = cfg_.preload ? images[c] : slot.image;
     if (image.width() != w || image.height() != h) {
       if (counters_.bad_frames.fetch_add(1, std::memory_order_relaxed) < 10)
-        spdlog::warn("dataset frame {} cam{}: image is {}x{}, the calibration says {}x{}; skipped", i, c,
-                     image.width(), image.height(), w, h);
+        spdlog::warn("dataset frame {} cam{}: image is {}x{}, the calibration says {}x{}; skipped", i, c, image.width(),
+                     image.height(), w, h);
       if (!cfg_.preload) slot.image.resize(w, h);  // the slot keeps its size (no allocation when it grew)
       continue;
     }

@@ -60,8 +60,11 @@ void SimSource::stop() {
 
 void SimSource::health(char* out, std::size_t size) const {
   const uint64_t skipped = skipped_.load(std::memory_order_relaxed);
-  if (skipped == 0) std::snprintf(out, size, "ok");
-  else std::snprintf(out, size, "ok, %llu sim frames skipped (rendering behind rate_hz)", static_cast<unsigned long long>(skipped));
+  if (skipped == 0)
+    std::snprintf(out, size, "ok");
+  else
+    std::snprintf(out, size, "ok, %llu sim frames skipped (rendering behind rate_hz)",
+                  static_cast<unsigned long long>(skipped));
 }
 
 bool SimSource::waitTurn(uint64_t next, int64_t start_mono, uint64_t& frame) {

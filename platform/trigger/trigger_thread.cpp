@@ -39,8 +39,10 @@ void TriggerThread::run() {
     if (!schedule.onWake(now)) continue;
     missed_.store(schedule.missed(), std::memory_order_relaxed);
     log_.record(index, now);
-    if (output_.fire(index)) fired_.fetch_add(1, std::memory_order_relaxed);
-    else failed_.fetch_add(1, std::memory_order_relaxed);
+    if (output_.fire(index))
+      fired_.fetch_add(1, std::memory_order_relaxed);
+    else
+      failed_.fetch_add(1, std::memory_order_relaxed);
     ++index;
   }
 }

@@ -47,8 +47,9 @@ UdpPoseSender::UdpPoseSender(std::vector<UdpDestination> destinations) : destina
     int& s = d.address.ss_family == AF_INET6 ? socket6_ : socket4_;
     if (s >= 0) continue;
     s = ::socket(d.address.ss_family, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (s < 0) throw InputError("publish.udp.destinations: cannot create a socket for '" + d.text + "': " +
-                                std::strerror(errno));
+    if (s < 0)
+      throw InputError("publish.udp.destinations: cannot create a socket for '" + d.text +
+                       "': " + std::strerror(errno));
   }
 }
 
@@ -65,8 +66,10 @@ void UdpPoseSender::send(const pose::PoseRecord& record) {
     const int s = d.address.ss_family == AF_INET6 ? socket6_ : socket4_;
     const ssize_t n = ::sendto(s, bytes, sizeof(bytes), MSG_DONTWAIT | MSG_NOSIGNAL,
                                reinterpret_cast<const sockaddr*>(&d.address), d.length);
-    if (n == static_cast<ssize_t>(sizeof(bytes))) sent_.fetch_add(1, std::memory_order_relaxed);
-    else failed_.fetch_add(1, std::memory_order_relaxed);
+    if (n == static_cast<ssize_t>(sizeof(bytes)))
+      sent_.fetch_add(1, std::memory_order_relaxed);
+    else
+      failed_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 

@@ -40,8 +40,8 @@ class Marginalizer {
   int num_ext_vars_ = 0;
   std::vector<int> ext_var_of_camera_;
   std::vector<ObservationLin> obs_;  // one landmark's observations (at most one per camera)
-  SchurAccumulator schur_;  // eliminates the exclusive landmarks
-  Eigen::MatrixXd H_;  // (6 + 6 n) square: [pose | extrinsics]
+  SchurAccumulator schur_;           // eliminates the exclusive landmarks
+  Eigen::MatrixXd H_;                // (6 + 6 n) square: [pose | extrinsics]
   Eigen::VectorXd g_;
   double c_ = 0;
   double pose_scale_ = 0;  // largest diagonal of the pose block before eliminating landmarks

@@ -6,9 +6,9 @@
 #include <string>
 
 #include "marginalizer.hpp"
-#include "mcslam/core/error.hpp"
 #include "mcslam/backend/levenberg_marquardt.hpp"
 #include "mcslam/backend/reprojection_residual.hpp"
+#include "mcslam/core/error.hpp"
 #include "reduced_system_solver.hpp"
 #include "window_linearization.hpp"
 #include "window_storage.hpp"

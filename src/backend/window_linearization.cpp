@@ -163,8 +163,7 @@ double WindowLinearization::linearizeLandmark(const WindowStorage& window, Landm
   return landmark_cost;
 }
 
-void WindowLinearization::linearize(const WindowStorage& window, MarginalizationPrior& prior,
-                                    bool select_landmarks) {
+void WindowLinearization::linearize(const WindowStorage& window, MarginalizationPrior& prior, bool select_landmarks) {
   updateTransforms(window);
   double cost = 0;
   landmarks_used_ = 0;
@@ -314,8 +313,7 @@ double WindowLinearization::stateSquaredNorm(const WindowStorage& window) const 
   return s;
 }
 
-bool WindowLinearization::evaluateTrial(const WindowStorage& window, const MarginalizationPrior& prior,
-                                        double& cost) {
+bool WindowLinearization::evaluateTrial(const WindowStorage& window, const MarginalizationPrior& prior, double& cost) {
   for (size_t s = 0; s < window.keyframes.size(); ++s) {
     const KeyframeState& kf = window.keyframes[s];
     if (!kf.used) continue;
@@ -343,8 +341,8 @@ bool WindowLinearization::evaluateTrial(const WindowStorage& window, const Margi
       if (!ref.active) continue;
       const ObservationState& ob = window.observations[ref.slot];
       Vec2 r;
-      if (!reprojectionResidualInverse(window.rig().model(ob.camera), T_b_w_[ob.keyframe], T_c_b_[ob.camera],
-                                       L.p_trial, ob.uv, ob.inv_sigma, r, nullptr)) {
+      if (!reprojectionResidualInverse(window.rig().model(ob.camera), T_b_w_[ob.keyframe], T_c_b_[ob.camera], L.p_trial,
+                                       ob.uv, ob.inv_sigma, r, nullptr)) {
         return false;
       }
       total += 0.5 * options_.loss.rho(r.squaredNorm());

@@ -75,7 +75,7 @@ class WindowLinearization {
     int slot;
     int begin, end;  // observation range
     bool active;
-    Mat3 H_inv;      // (H_ll + mu D_l)^-1 of the last build
+    Mat3 H_inv;  // (H_ll + mu D_l)^-1 of the last build
     Vec3 g;
     Vec3 D;
     Vec3 dx;
@@ -104,9 +104,9 @@ class WindowLinearization {
   std::vector<int> pose_block_;  // per keyframe slot
   std::vector<int> ext_block_;   // per camera
   int num_blocks_ = 0;
-  std::vector<SE3> T_b_w_;       // per keyframe slot
-  std::vector<SE3> T_c_b_;       // per camera, current
-  std::vector<SE3> T_c_b_jac_;   // per camera, where Jacobians are evaluated (first estimate)
+  std::vector<SE3> T_b_w_;      // per keyframe slot
+  std::vector<SE3> T_c_b_;      // per camera, current
+  std::vector<SE3> T_c_b_jac_;  // per camera, where Jacobians are evaluated (first estimate)
   std::vector<uint8_t> use_fej_;
 
   std::vector<LandmarkLin> landmarks_;
@@ -124,9 +124,9 @@ class WindowLinearization {
 
   // Reduced camera system.
   Eigen::MatrixXd S_;
-  Eigen::VectorXd g_c_;     // gradient of the camera variables (before elimination)
-  Eigen::VectorXd D_c_;     // clamped diagonal of H_cc
-  Eigen::VectorXd rhs_;     // -(reduced gradient)
+  Eigen::VectorXd g_c_;  // gradient of the camera variables (before elimination)
+  Eigen::VectorXd D_c_;  // clamped diagonal of H_cc
+  Eigen::VectorXd rhs_;  // -(reduced gradient)
   Eigen::VectorXd dx_c_;
   double max_gradient_ = 0;
   std::vector<uint8_t> pattern_;

@@ -30,8 +30,8 @@ class WindowScaleHold final : public WindowTerm {
   double residual(double held_distance) const { return (std::log(held_distance) - log_reference_) / kSigma; }
 
   bool active_ = false;
-  int anchor_ = -1;               // keyframe slot
-  std::vector<int> held_slots_;   // the first num_held_
+  int anchor_ = -1;              // keyframe slot
+  std::vector<int> held_slots_;  // the first num_held_
   int num_held_ = 0;
   double log_reference_ = 0;
   double r_ = 0;

@@ -40,12 +40,12 @@ struct ObservationState {
 // estimate) and move d; the others are rebased after every step (T_lin = T, d = 0), which makes
 // their update the usual right perturbation.
 struct ExtrinsicState {
-  SE3 T_calib;      // the calibration: mean of the extrinsic prior
+  SE3 T_calib;  // the calibration: mean of the extrinsic prior
   SE3 T_lin;
   Vec6 d = Vec6::Zero();
   SE3 T;
-  bool variable = false;  // refined (not the reference camera, refinement on)
-  bool in_prior = false;  // linked to the marginalization prior
+  bool variable = false;          // refined (not the reference camera, refinement on)
+  bool in_prior = false;          // linked to the marginalization prior
   bool calibration_prior = true;  // false once an outside estimate showed the calibration wrong
 };
 
@@ -77,13 +77,13 @@ class WindowStorage {
   Status addObservation(int64_t keyframe_id, int64_t landmark_id, int camera, const Vec2& uv, double sigma_px);
   Status removeObservation(const ObservationKey& key);
   Status removeLandmark(int64_t id);
-  void removeObservationSlot(int obs);    // unlinks from its landmark and frees the slot
-  void removeLandmarkSlot(int lm);        // with its observations
-  void removeKeyframeSlot(int kf);        // the caller has removed its observations
+  void removeObservationSlot(int obs);  // unlinks from its landmark and frees the slot
+  void removeLandmarkSlot(int lm);      // with its observations
+  void removeKeyframeSlot(int kf);      // the caller has removed its observations
 
   int keyframeSlot(int64_t id) const { return keyframe_ids_.find(id); }
   int landmarkSlot(int64_t id) const { return landmark_ids_.find(id); }
-  int oldestKeyframe() const;             // slot, -1 when empty
+  int oldestKeyframe() const;  // slot, -1 when empty
 
   const Rig& rig() const { return rig_; }
   int numCameras() const { return rig_.size(); }

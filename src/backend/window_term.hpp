@@ -15,11 +15,11 @@ namespace mcslam::backend {
 // trial state of the step being tried. Valid for one call.
 struct WindowVariables {
   const WindowStorage& window;
-  std::span<const int> pose_block;  // per keyframe slot: block of its pose, < 0 when held
-  std::span<const int> ext_block;   // per camera: block of its extrinsic, < 0 when not refined
-  std::span<const uint8_t> use_fej;  // per camera: Jacobians at the extrinsic's first estimate
-  std::span<const SE3> kf_trial;    // per keyframe slot, T_w_b at the trial step
-  std::span<const SE3> ext_trial;   // per camera, T_b_c at the trial step
+  std::span<const int> pose_block;    // per keyframe slot: block of its pose, < 0 when held
+  std::span<const int> ext_block;     // per camera: block of its extrinsic, < 0 when not refined
+  std::span<const uint8_t> use_fej;   // per camera: Jacobians at the extrinsic's first estimate
+  std::span<const SE3> kf_trial;      // per keyframe slot, T_w_b at the trial step
+  std::span<const SE3> ext_trial;     // per camera, T_b_c at the trial step
   std::span<const Vec6> ext_d_trial;  // per camera, its d (T = T_lin exp(d)) at the trial step
 };
 

@@ -170,7 +170,8 @@ Rig loadKalibrRig(const std::string& path, const RigLoadOptions& options) {
 
 Rig parseKalibrRig(const std::string& yaml_text, const std::string& source, const RigLoadOptions& options) {
   const YAML::Node root = parseYaml(yaml_text, source);
-  if (!root.IsMap()) throw InputError(source + ": expected a Kalibr camchain (keys cam0, cam1, ...), got " + describe(root));
+  if (!root.IsMap())
+    throw InputError(source + ": expected a Kalibr camchain (keys cam0, cam1, ...), got " + describe(root));
 
   std::map<int, YAML::Node> cams;
   for (const auto& kv : root) {
@@ -184,7 +185,8 @@ Rig parseKalibrRig(const std::string& yaml_text, const std::string& source, cons
   int expected = 0;
   for (const auto& [index, node] : cams) {
     if (index != expected) {
-      throw InputError(source + ": cam" + std::to_string(expected) + " is missing (cameras must be numbered cam0, cam1, ... without gaps)");
+      throw InputError(source + ": cam" + std::to_string(expected) +
+                       " is missing (cameras must be numbered cam0, cam1, ... without gaps)");
     }
     ++expected;
   }
@@ -200,8 +202,10 @@ Rig parseKalibrRig(const std::string& yaml_text, const std::string& source, cons
     rc.name = name;
     rc.source_index = index;
     rc.model = readCameraModel(node, w, "distortion_coeffs");
-    if (node["T_cam_imu"]) T_c_imu[index] = readTransform(node, w, "T_cam_imu");
-    else if (node["T_imu_cam"]) T_c_imu[index] = readTransform(node, w, "T_imu_cam").inverse();
+    if (node["T_cam_imu"])
+      T_c_imu[index] = readTransform(node, w, "T_cam_imu");
+    else if (node["T_imu_cam"])
+      T_c_imu[index] = readTransform(node, w, "T_imu_cam").inverse();
 
     if (index == 0) {
       T_c_c0[0] = SE3();
@@ -232,7 +236,8 @@ Rig loadEurocSensorRig(const std::vector<std::string>& paths, const RigLoadOptio
     RigCamera rc;
     rc.name = name;
     rc.source_index = static_cast<int>(i);
-    rc.model = readCameraModel(root, w, root["distortion_coefficients"] ? "distortion_coefficients" : "distortion_coeffs");
+    rc.model =
+        readCameraModel(root, w, root["distortion_coefficients"] ? "distortion_coefficients" : "distortion_coeffs");
     T_B_c.push_back(readTransform(root, w, "T_BS"));
     rig.cameras.push_back(rc);
   }

@@ -66,8 +66,8 @@ void CameraModel::computeValidDomain() {
     // Beyond the image the polynomial was never calibrated and grows wildly: keep the domain to twice
     // the radius the image corners reach.
     double corner_r2 = 0;
-    for (const Vec2& corner : {Vec2(-0.5, -0.5), Vec2(width_ - 0.5, -0.5), Vec2(-0.5, height_ - 0.5),
-                              Vec2(width_ - 0.5, height_ - 0.5)}) {
+    for (const Vec2& corner :
+         {Vec2(-0.5, -0.5), Vec2(width_ - 0.5, -0.5), Vec2(-0.5, height_ - 0.5), Vec2(width_ - 0.5, height_ - 0.5)}) {
       Vec3 ray;
       if (unproject(corner, ray) && ray.z() > 0)
         corner_r2 = std::max(corner_r2, ray.head<2>().squaredNorm() / (ray.z() * ray.z()));

@@ -11,7 +11,8 @@ namespace mcslam {
 ConfigSection::ConfigSection(const YAML::Node& node, std::string path, std::string source)
     : node_(node), path_(std::move(path)), source_(std::move(source)) {
   if (node_ && !node_.IsNull() && !node_.IsMap()) {
-    throw InputError(source_ + ": " + (path_.empty() ? std::string("configuration") : path_) + ": must be a map of keys");
+    throw InputError(source_ + ": " + (path_.empty() ? std::string("configuration") : path_) +
+                     ": must be a map of keys");
   }
 }
 
@@ -89,7 +90,8 @@ void ConfigSection::read(const char* key, std::vector<double>& value, std::size_
   if (!has(key)) return;
   const YAML::Node n = node_[key];
   if (!n.IsSequence() || (count && n.size() != count)) {
-    fail(key, count ? "must be a list of " + std::to_string(count) + " numbers" : std::string("must be a list of numbers"));
+    fail(key,
+         count ? "must be a list of " + std::to_string(count) + " numbers" : std::string("must be a list of numbers"));
   }
   std::vector<double> out;
   for (std::size_t i = 0; i < n.size(); ++i) {

@@ -63,7 +63,8 @@ void WorkerPool::run(PoolJob& job, int tasks) {
 
 // The hand-out is one counter: its modification order is the order in which tasks are taken.
 void WorkerPool::drain(int thread) {
-  for (int t = next_.fetch_add(1, std::memory_order_relaxed); t < tasks_; t = next_.fetch_add(1, std::memory_order_relaxed)) {
+  for (int t = next_.fetch_add(1, std::memory_order_relaxed); t < tasks_;
+       t = next_.fetch_add(1, std::memory_order_relaxed)) {
     job_->run(t, thread);
   }
 }

@@ -37,7 +37,8 @@ std::vector<std::string> splitCsv(const std::string& line) {
 std::unordered_set<std::string> fileNames(const fs::path& dir) {
   std::unordered_set<std::string> names;
   std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) names.insert(it->path().filename().string());
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    names.insert(it->path().filename().string());
   return names;
 }
 
@@ -50,7 +51,8 @@ class AslLayout : public DatasetLayout {
   Rig loadRig() const override {
     const fs::path calib = fs::path(root_) / "camchain.yaml";
     if (!fs::exists(calib)) {
-      throw InputError(root_ + ": no camchain.yaml (the ASL layout's Kalibr calibration); give one with the calibration option");
+      throw InputError(
+          root_ + ": no camchain.yaml (the ASL layout's Kalibr calibration); give one with the calibration option");
     }
     return loadKalibrRig(calib.string());
   }
@@ -74,13 +76,15 @@ class AslLayout : public DatasetLayout {
 
 void MissingImageReport::add(const std::string& where, const std::string& path) {
   if (++count_ <= kListedMissing) {
-    warnings_.push_back(where + ": image " + path + " is listed but missing; " + camera_ + " is absent from that frame");
+    warnings_.push_back(where + ": image " + path + " is listed but missing; " + camera_ +
+                        " is absent from that frame");
   }
 }
 
 void MissingImageReport::finish() {
   if (count_ > kListedMissing) {
-    warnings_.push_back("... and " + std::to_string(count_ - kListedMissing) + " more listed but missing images of " + camera_);
+    warnings_.push_back("... and " + std::to_string(count_ - kListedMissing) + " more listed but missing images of " +
+                        camera_);
   }
 }
 
@@ -126,8 +130,8 @@ std::vector<CameraImage> readAslImageList(const std::string& camera_dir, std::ve
   std::vector<CameraImage> unique;
   for (CameraImage& img : images) {
     if (!unique.empty() && unique.back().t == img.t) {
-      warnings.push_back(csv.string() + ": two images at " + std::to_string(img.t) + " ns; keeping " + unique.back().path +
-                         ", ignoring " + img.path);
+      warnings.push_back(csv.string() + ": two images at " + std::to_string(img.t) + " ns; keeping " +
+                         unique.back().path + ", ignoring " + img.path);
       continue;
     }
     unique.push_back(std::move(img));

@@ -24,7 +24,8 @@ std::unique_ptr<DatasetLayout> detectLayout(const std::string& dir) {
   if (!has_camchain && (d.filename() == "mav0" || fs::exists(d / "cam0" / "sensor.yaml"))) return makeEurocLayout(dir);
   if (fs::exists(d / "calib.txt") && fs::is_directory(d / "image_0")) return makeKittiLayout(dir);
   if (has_camchain || fs::exists(d / "cam0" / "data.csv")) return makeAslLayout(dir);
-  throw InputError(dir + ": not a dataset folder: expected camchain.yaml and camN/data.csv (ASL), mav0/ (EuRoC) or "
+  throw InputError(dir +
+                   ": not a dataset folder: expected camchain.yaml and camN/data.csv (ASL), mav0/ (EuRoC) or "
                    "calib.txt, times.txt and image_0/ (KITTI)");
 }
 
@@ -37,7 +38,8 @@ class DatasetBuilder {
     Dataset ds;
     ds.dir_ = dir;
     ds.format_ = layout->format();
-    const Rig full = options.calibration_override.empty() ? layout->loadRig() : loadRigFromPath(options.calibration_override);
+    const Rig full =
+        options.calibration_override.empty() ? layout->loadRig() : loadRigFromPath(options.calibration_override);
 
     std::vector<int> selected = options.cameras;
     if (selected.empty()) {
@@ -80,9 +82,12 @@ class DatasetBuilder {
   }
 };
 
-Dataset Dataset::open(const std::string& dir, const DatasetOptions& options) { return DatasetBuilder::open(dir, options); }
+Dataset Dataset::open(const std::string& dir, const DatasetOptions& options) {
+  return DatasetBuilder::open(dir, options);
+}
 
-int Dataset::loadImages(std::size_t i, std::vector<Image>& images, std::vector<bool>& present, std::string* error) const {
+int Dataset::loadImages(std::size_t i, std::vector<Image>& images, std::vector<bool>& present,
+                        std::string* error) const {
   const int n = rig_.size();
   if (static_cast<int>(images.size()) < n) images.resize(n);
   present.assign(n, false);
@@ -110,8 +115,9 @@ int Dataset::loadImages(std::size_t i, std::vector<Image>& images, std::vector<b
     }
     const CameraModel& m = rig_.model(c);
     if (img.width() != m.width() || img.height() != m.height()) {
-      report(path + ": image is " + std::to_string(img.width()) + "x" + std::to_string(img.height()) + " but the calibration of " +
-             rig_.cameras[c].name + " says " + std::to_string(m.width()) + "x" + std::to_string(m.height()) + "; left out");
+      report(path + ": image is " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +
+             " but the calibration of " + rig_.cameras[c].name + " says " + std::to_string(m.width()) + "x" +
+             std::to_string(m.height()) + "; left out");
       continue;
     }
     present[c] = true;

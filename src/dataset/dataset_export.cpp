@@ -66,7 +66,8 @@ void writeTextFile(const fs::path& path, const std::string& text) {
 // A hard link keeps the bytes and costs no space; across file systems (or where links are refused) a copy.
 void placeImage(const std::string& source, const fs::path& target, bool must_be_png) {
   std::string ext = fs::path(source).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (must_be_png && ext != ".png") {
     const cv::Mat grey = cv::imread(source, cv::IMREAD_GRAYSCALE);
     if (grey.empty()) throw InputError(source + ": cannot read image");
@@ -87,7 +88,8 @@ std::vector<std::optional<SE3>> groundTruthPerFrame(const Dataset& dataset) {
   const Timestamp tol = std::max<Timestamp>(dataset.syncToleranceNs(), 1000);
   for (std::size_t i = 0; i < dataset.size(); ++i) {
     const Timestamp t = dataset.frames()[i].t;
-    const auto it = std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& p, Timestamp s) { return p.t < s; });
+    const auto it =
+        std::lower_bound(gt.begin(), gt.end(), t, [](const StampedPose& p, Timestamp s) { return p.t < s; });
     const StampedPose* best = nullptr;
     if (it != gt.end()) best = &*it;
     if (it != gt.begin() && (!best || t - std::prev(it)->t < best->t - t)) best = &*std::prev(it);
@@ -112,7 +114,8 @@ std::vector<std::vector<CameraImage>> imagesPerCamera(const Dataset& dataset) {
 // camN/data.csv and camN/data/<ns>.<ext> of every camera (ASL and EuRoC share this part); returns the images
 // written, per camera.
 std::vector<std::vector<CameraImage>> writeAslCameras(const Dataset& dataset, const fs::path& root,
-                                                      const DatasetExportOptions& options, DatasetExportReport& report) {
+                                                      const DatasetExportOptions& options,
+                                                      DatasetExportReport& report) {
   auto images = imagesPerCamera(dataset);
   const bool pgm = options.images == ExportImages::Pgm;
   Image pixels;  // reused for every image re-written as PGM
@@ -121,7 +124,8 @@ std::vector<std::vector<CameraImage>> writeAslCameras(const Dataset& dataset, co
     createFolder(cam / "data");
     std::string csv = "#timestamp [ns],filename\n";
     for (const CameraImage& im : images[c]) {
-      const std::string name = std::to_string(im.t) + (pgm ? std::string(".pgm") : fs::path(im.path).extension().string());
+      const std::string name =
+          std::to_string(im.t) + (pgm ? std::string(".pgm") : fs::path(im.path).extension().string());
       if (pgm) {
         readGreyImageFile(im.path, pixels);
         writePgmFile((cam / "data" / name).string(), pixels.view());
@@ -157,7 +161,8 @@ std::string eurocSensorYaml(const CameraModel& m, const SE3& T_B_c, double rate_
   os << "resolution: [" << m.width() << ", " << m.height() << "]\ncamera_model: pinhole\n";
   os << "intrinsics: [" << m.fx() << ", " << m.fy() << ", " << m.cx() << ", " << m.cy() << "] #fu, fv, cu, cv\n";
   // No distortion is radial-tangential with zero coefficients: what EuRoC readers expect.
-  os << "distortion_model: " << (m.distortion() == Distortion::Equidistant ? "equidistant" : "radial-tangential") << "\n";
+  os << "distortion_model: " << (m.distortion() == Distortion::Equidistant ? "equidistant" : "radial-tangential")
+     << "\n";
   const auto& k = m.coeffs();
   os << "distortion_coefficients: [" << k[0] << ", " << k[1] << ", " << k[2] << ", " << k[3] << "]\n";
   return os.str();
@@ -190,7 +195,8 @@ void exportEuroc(const Dataset& dataset, const fs::path& root, const DatasetExpo
                   eurocSensorYaml(rig.model(c), T_b_B.inverse() * rig.T_b_c(c), cameraRateHz(images[c]), c));
   }
   if (!dataset.groundTruth()) return;
-  std::string csv = "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z []\n";
+  std::string csv =
+      "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z []\n";
   char buf[256];
   for (const StampedPose& p : *dataset.groundTruth()) {
     const SE3 T_w_B = p.T_w_b * T_b_B;
@@ -212,7 +218,8 @@ DatasetExportReport exportDataset(const Dataset& dataset, DatasetLayoutKind layo
   DatasetExportReport report;
   if (layout == DatasetLayoutKind::Kitti) {  // refused before anything is written
     if (options.images != ExportImages::Original)
-      throw InputError(out_dir + ": the KITTI layout holds PNG images only (image_N/000000.png); PGM images are for "
+      throw InputError(out_dir +
+                       ": the KITTI layout holds PNG images only (image_N/000000.png); PGM images are for "
                        "the asl and euroc layouts");
     detail::checkKittiRig(dataset.rig());
   }

@@ -27,7 +27,9 @@ class DatasetLayout {
   virtual std::optional<Trajectory> loadGroundTruth(const Rig& rig, std::vector<std::string>& warnings,
                                                     std::string* source) const = 0;
   // A ground truth file named by the user, in this layout's format, in the body frame of `rig`.
-  virtual Trajectory readGroundTruthFile(const std::string& path, const Rig& rig) const { return readTumTrajectory(path); }
+  virtual Trajectory readGroundTruthFile(const std::string& path, const Rig& rig) const {
+    return readTumTrajectory(path);
+  }
 };
 
 // Throws InputError naming the folder when it is no dataset this reader knows.
@@ -43,7 +45,8 @@ std::vector<CameraImage> readAslImageList(const std::string& camera_dir, std::ve
 // Collects "listed but missing" warnings for one camera, summarising after the first few.
 class MissingImageReport {
  public:
-  MissingImageReport(std::string camera, std::vector<std::string>& warnings) : camera_(std::move(camera)), warnings_(warnings) {}
+  MissingImageReport(std::string camera, std::vector<std::string>& warnings)
+      : camera_(std::move(camera)), warnings_(warnings) {}
   void add(const std::string& where, const std::string& path);
   // Adds the summary line of what add() did not list.
   void finish();

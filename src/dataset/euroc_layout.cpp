@@ -23,7 +23,8 @@ Trajectory readEurocGroundTruthCsv(const std::string& path) {
   Trajectory traj;
   std::string line;
   int line_no = 0;
-  static const char* kNames[8] = {"timestamp", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z", "q_RS_w", "q_RS_x", "q_RS_y", "q_RS_z"};
+  static const char* kNames[8] = {"timestamp", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z",
+                                  "q_RS_w",    "q_RS_x",   "q_RS_y",   "q_RS_z"};
   while (std::getline(in, line)) {
     ++line_no;
     const std::string where = path + ": line " + std::to_string(line_no);
@@ -55,7 +56,8 @@ Trajectory readEurocGroundTruthCsv(const std::string& path) {
     }
     const Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
     if (std::abs(q.norm() - 1.0) > 1e-2) {
-      throw InputError(where + ": quaternion q_RS (w x y z) is not of unit length (norm " + std::to_string(q.norm()) + ")");
+      throw InputError(where + ": quaternion q_RS (w x y z) is not of unit length (norm " + std::to_string(q.norm()) +
+                       ")");
     }
     p.T_w_b = SE3(q, Vec3(v[1], v[2], v[3]));
     traj.push_back(p);
@@ -65,7 +67,8 @@ Trajectory readEurocGroundTruthCsv(const std::string& path) {
 
 Trajectory toBodyFrame(Trajectory traj, const Rig& rig, const std::string& path) {
   if (!rig.T_b_imu) {
-    throw InputError(path + ": EuRoC ground truth is the IMU pose, but the calibration gives no camera-IMU transform "
+    throw InputError(path +
+                     ": EuRoC ground truth is the IMU pose, but the calibration gives no camera-IMU transform "
                      "(T_BS / T_cam_imu) to bring it into the body frame");
   }
   const SE3 T_imu_b = rig.T_b_imu->inverse();
@@ -99,7 +102,8 @@ class EurocLayout : public DatasetLayout {
     const fs::path gt = fs::path(root_) / "state_groundtruth_estimate0" / "data.csv";
     if (!fs::exists(gt)) return std::nullopt;
     if (!rig.T_b_imu) {
-      warnings.push_back(gt.string() + ": ground truth left out: the calibration gives no camera-IMU transform to "
+      warnings.push_back(gt.string() +
+                         ": ground truth left out: the calibration gives no camera-IMU transform to "
                          "bring the IMU poses into the body frame");
       return std::nullopt;
     }

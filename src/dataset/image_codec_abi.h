@@ -22,7 +22,7 @@ typedef int (*mcslam_image_codec_abi_fn)(void);
 // Decodes the image file at `path` as 8-bit grey into the buffer `target` gives. Returns 0 on success; otherwise
 // writes a NUL-terminated reason (without the path) into error[error_size].
 typedef int (*mcslam_image_codec_read_fn)(const char* path, mcslam_grey_target_fn target, void* context, char* error,
-                                           size_t error_size);
+                                          size_t error_size);
 
 #ifdef __cplusplus
 }

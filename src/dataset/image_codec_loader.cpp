@@ -60,7 +60,8 @@ ImageCodecModule loadImageCodecModule(const std::vector<std::string>& candidates
     tried += (tried.empty() ? "" : "; ") + path + " (" + reason + ")";
   }
   module.failure = "decoding it needs the image codec module " MCSLAM_IMAGE_CODEC_FILE_NAME
-                   ", which did not load: tried " + (tried.empty() ? std::string("no path") : tried) +
+                   ", which did not load: tried " +
+                   (tried.empty() ? std::string("no path") : tried) +
                    ". Binary PGM needs no module: mcslam-dataset convert --images pgm writes a dataset's images so";
   return module;
 }

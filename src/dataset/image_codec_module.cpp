@@ -23,9 +23,9 @@ extern "C" __attribute__((visibility("default"))) int mcslam_image_codec_abi_ver
 }
 
 extern "C" __attribute__((visibility("default"))) int mcslam_image_codec_read_grey(const char* path,
-                                                                                  mcslam_grey_target_fn target,
-                                                                                  void* context, char* error,
-                                                                                  size_t error_size) {
+                                                                                   mcslam_grey_target_fn target,
+                                                                                   void* context, char* error,
+                                                                                   size_t error_size) {
   try {
     const cv::Mat grey = cv::imread(path, cv::IMREAD_GRAYSCALE);
     if (grey.empty())
@@ -33,7 +33,8 @@ extern "C" __attribute__((visibility("default"))) int mcslam_image_codec_read_gr
     ptrdiff_t stride = 0;
     uint8_t* out = target(context, grey.cols, grey.rows, &stride);
     if (!out) return fail(error, error_size, "no buffer for the decoded image");
-    for (int y = 0; y < grey.rows; ++y) std::memcpy(out + y * stride, grey.ptr<uint8_t>(y), static_cast<size_t>(grey.cols));
+    for (int y = 0; y < grey.rows; ++y)
+      std::memcpy(out + y * stride, grey.ptr<uint8_t>(y), static_cast<size_t>(grey.cols));
     return 0;
   } catch (const std::exception& e) {
     return fail(error, error_size, e.what());

@@ -66,17 +66,19 @@ long pgmField(const uint8_t* head, std::size_t n, std::size_t& pos, const char* 
   while (pos < n && std::isdigit(head[pos])) value = std::min(value * 10 + (head[pos++] - '0'), kSaturated);
   if (pos == start || pos >= n || !std::isspace(head[pos])) {
     const bool cut = pos >= n;
-    throw InputError(path + ": PGM header: " + field +
-                     (cut ? (n < kPgmHeaderBytes ? " missing (file truncated)"
-                                                 : " not found in the first " + std::to_string(kPgmHeaderBytes) + " bytes")
-                          : " is not a number"));
+    throw InputError(
+        path + ": PGM header: " + field +
+        (cut ? (n < kPgmHeaderBytes ? " missing (file truncated)"
+                                    : " not found in the first " + std::to_string(kPgmHeaderBytes) + " bytes")
+             : " is not a number"));
   }
   return value;
 }
 
 // Parses the header in head[0, n) (magic already checked), then reads the pixels: those already in `head` and
 // the rest straight from the file into `image`.
-void readPgmPixels(const FileDescriptor& file, const std::string& path, const uint8_t* head, std::size_t n, Image& image) {
+void readPgmPixels(const FileDescriptor& file, const std::string& path, const uint8_t* head, std::size_t n,
+                   Image& image) {
   std::size_t pos = 2;
   const long width = pgmField(head, n, pos, "width", path);
   const long height = pgmField(head, n, pos, "height", path);
@@ -85,11 +87,13 @@ void readPgmPixels(const FileDescriptor& file, const std::string& path, const ui
   for (const auto& [name, value] : {std::pair{"width", width}, std::pair{"height", height}}) {
     if (value < 1 || value > kMaxPgmSide)
       throw InputError(path + ": PGM header: " + name + " " + std::to_string(value) +
-                       (value == kSaturated ? " or more" : "") + " (expected 1 to " + std::to_string(kMaxPgmSide) + ")");
+                       (value == kSaturated ? " or more" : "") + " (expected 1 to " + std::to_string(kMaxPgmSide) +
+                       ")");
   }
   if (maxval != 255)
-    throw InputError(path + ": PGM header: maxval " + std::to_string(maxval) + (maxval == kSaturated ? " or more" : "") +
-                     " (only 8-bit grey with maxval 255 is read" + (maxval > 255 ? "; this is a 16-bit image)" : ")"));
+    throw InputError(path + ": PGM header: maxval " + std::to_string(maxval) +
+                     (maxval == kSaturated ? " or more" : "") + " (only 8-bit grey with maxval 255 is read" +
+                     (maxval > 255 ? "; this is a 16-bit image)" : ")"));
   image.resize(static_cast<int>(width), static_cast<int>(height));
   const std::size_t total = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   const std::size_t buffered = std::min(n - std::min(pos, n), total);

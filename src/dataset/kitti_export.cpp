@@ -25,7 +25,8 @@ void checkKittiRig(const Rig& rig) {
     const double angle = Eigen::AngleAxisd(R0.transpose() * rig.T_b_c(c).R).angle();
     if (angle > 1e-6) {
       char buf[160];
-      std::snprintf(buf, sizeof(buf), ": turned %.4f deg from %s: the KITTI layout holds rectified cameras only (same orientation)",
+      std::snprintf(buf, sizeof(buf),
+                    ": turned %.4f deg from %s: the KITTI layout holds rectified cameras only (same orientation)",
                     angle * 180.0 / M_PI, rig.cameras[0].name.c_str());
       throw InputError(rig.cameras[c].name + buf);
     }

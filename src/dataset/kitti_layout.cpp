@@ -41,7 +41,8 @@ std::map<std::string, Mat34> readProjections(const std::string& path) {
       char* end = nullptr;
       const double x = std::strtod(tok.c_str(), &end);
       if (end != tok.c_str() + tok.size() || !std::isfinite(x)) {
-        throw InputError(path + ": line " + std::to_string(line_no) + ": " + key + " entry is not a number: '" + tok + "'");
+        throw InputError(path + ": line " + std::to_string(line_no) + ": " + key + " entry is not a number: '" + tok +
+                         "'");
       }
       v.push_back(x);
     }
@@ -54,8 +55,9 @@ std::map<std::string, Mat34> readProjections(const std::string& path) {
     const Mat3 K = P.leftCols<3>();
     if (!(K(0, 0) > 0 && K(1, 1) > 0) || std::abs(K(1, 0)) + std::abs(K(2, 0)) + std::abs(K(2, 1)) > 1e-9 ||
         std::abs(K(2, 2) - 1.0) > 1e-9) {
-      throw InputError(path + ": line " + std::to_string(line_no) + ": " + key +
-                       " is not a rectified projection K [I | t] (K upper triangular, positive focal lengths, K(2,2) = 1)");
+      throw InputError(
+          path + ": line " + std::to_string(line_no) + ": " + key +
+          " is not a rectified projection K [I | t] (K upper triangular, positive focal lengths, K(2,2) = 1)");
     }
     out[key] = P;
   }
@@ -101,10 +103,12 @@ class KittiLayout : public DatasetLayout {
   std::vector<CameraImage> listImages(int cam, std::vector<std::string>& warnings) const override {
     const std::vector<Timestamp>& t = times();
     const fs::path dir = cameraDir(cam);
-    if (!fs::is_directory(dir)) throw InputError(dir.string() + ": missing (the images of cam" + std::to_string(cam) + ")");
+    if (!fs::is_directory(dir))
+      throw InputError(dir.string() + ": missing (the images of cam" + std::to_string(cam) + ")");
     std::unordered_set<std::string> present;
     std::error_code ec;
-    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) present.insert(it->path().filename().string());
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+      present.insert(it->path().filename().string());
     MissingImageReport missing("cam" + std::to_string(cam), warnings);
     std::vector<CameraImage> images;
     for (std::size_t i = 0; i < t.size(); ++i) {
@@ -122,7 +126,8 @@ class KittiLayout : public DatasetLayout {
     return images;
   }
 
-  std::optional<Trajectory> loadGroundTruth(const Rig& rig, std::vector<std::string>&, std::string* source) const override {
+  std::optional<Trajectory> loadGroundTruth(const Rig& rig, std::vector<std::string>&,
+                                            std::string* source) const override {
     // poses.txt beside the images, or the odometry benchmark's dataset/poses/<sequence>.txt.
     const fs::path root = fs::absolute(fs::path(root_)).lexically_normal();
     const fs::path here = root / "poses.txt";

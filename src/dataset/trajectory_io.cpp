@@ -117,8 +117,8 @@ std::string formatTumTrajectory(const Trajectory& traj) {
   char buf[256];
   for (const StampedPose& p : traj) {
     const Eigen::Quaterniond q = p.T_w_b.quaternion();
-    std::snprintf(buf, sizeof(buf), "%s %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", toSecondsString(p.t).c_str(), p.T_w_b.t.x(),
-                  p.T_w_b.t.y(), p.T_w_b.t.z(), q.x(), q.y(), q.z(), q.w());
+    std::snprintf(buf, sizeof(buf), "%s %.9f %.9f %.9f %.12f %.12f %.12f %.12f\n", toSecondsString(p.t).c_str(),
+                  p.T_w_b.t.x(), p.T_w_b.t.y(), p.T_w_b.t.z(), q.x(), q.y(), q.z(), q.w());
     os << buf;
   }
   return os.str();

@@ -1,8 +1,8 @@
 #include "mcslam/eval/association.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "first_nearest.hpp"
@@ -28,7 +28,9 @@ std::vector<double> secondsOf(const Trajectory& traj, double offset) {
 
 // Index of the first minimum of |stamps[j] - t| (numpy argmin semantics).
 std::size_t nearestIndex(const std::vector<double>& stamps, bool sorted, double t) {
-  if (sorted) return detail::firstNearest(0, stamps.size(), [&](std::size_t j) { return stamps[j]; }, t);
+  if (sorted)
+    return detail::firstNearest(
+        0, stamps.size(), [&](std::size_t j) { return stamps[j]; }, t);
   std::size_t best = 0;
   for (std::size_t j = 1; j < stamps.size(); ++j) {
     if (std::abs(stamps[j] - t) < std::abs(stamps[best] - t)) best = j;

@@ -12,8 +12,10 @@ std::size_t firstNearest(std::size_t begin, std::size_t end, const Value& value,
   std::size_t lo = begin, hi = end;
   while (lo < hi) {
     const std::size_t mid = lo + (hi - lo) / 2;
-    if (value(mid) < target) lo = mid + 1;
-    else hi = mid;
+    if (value(mid) < target)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   const std::size_t above = lo;
   if (above == begin) return begin;
@@ -23,8 +25,10 @@ std::size_t firstNearest(std::size_t begin, std::size_t end, const Value& value,
   hi = above - 1;
   while (lo < hi) {
     const std::size_t mid = lo + (hi - lo) / 2;
-    if (value(mid) < below_value) lo = mid + 1;
-    else hi = mid;
+    if (value(mid) < below_value)
+      lo = mid + 1;
+    else
+      hi = mid;
   }
   const std::size_t below = lo;
   if (above == end) return below;

@@ -57,7 +57,8 @@ void dashedLine(cv::Mat& img, cv::Point2d a, cv::Point2d b, const cv::Scalar& co
 cv::Scalar errorColour(double v) {
   // A blue -> teal -> yellow -> orange -> dark red ramp: every part stays visible on white, and the
   // order reads as "worse" without a legend.
-  static const double kStops[][3] = {  // RGB
+  static const double kStops[][3] = {
+      // RGB
       {49, 54, 149}, {69, 117, 180}, {116, 173, 209}, {102, 189, 99}, {240, 200, 40}, {244, 109, 67}, {165, 0, 38}};
   constexpr int kN = sizeof(kStops) / sizeof(kStops[0]);
   v = std::clamp(std::isfinite(v) ? v : 0.0, 0.0, 1.0) * (kN - 1);

@@ -29,7 +29,8 @@ std::string formatSeconds(double s) {
 AlignedTrajectories associateAndAlign(const Trajectory& ref, const Trajectory& est, const EvalOptions& options) {
   if (ref.empty()) throw InputError(options.reference_name + ": the reference trajectory has no poses");
   if (est.empty()) throw InputError(options.estimate_name + ": the estimated trajectory has no poses");
-  if (!(options.max_diff_s >= 0)) throw InputError("max. time difference must be >= 0 s, got " + formatSeconds(options.max_diff_s));
+  if (!(options.max_diff_s >= 0))
+    throw InputError("max. time difference must be >= 0 s, got " + formatSeconds(options.max_diff_s));
   const TimeAssociation assoc = associateByTime(ref, est, options.max_diff_s, options.t_offset_s);
   if (assoc.size() == 0) {
     throw InputError("no matching timestamps between " + describeSpan(options.reference_name, ref) + " and " +
@@ -61,7 +62,8 @@ ApeResult computeApe(const Trajectory& ref, const Trajectory& est, const EvalOpt
   ApeResult r;
   r.data = associateAndAlign(ref, est, options);
   r.errors.reserve(r.data.ref.size());
-  for (std::size_t i = 0; i < r.data.ref.size(); ++i) r.errors.push_back((r.data.est[i].T_w_b.t - r.data.ref[i].T_w_b.t).norm());
+  for (std::size_t i = 0; i < r.data.ref.size(); ++i)
+    r.errors.push_back((r.data.est[i].T_w_b.t - r.data.ref[i].T_w_b.t).norm());
   r.stats = computeErrorStats(r.errors);
   r.rmse_percent = r.data.ref_path_length > 0 ? 100.0 * r.stats.rmse / r.data.ref_path_length : 0.0;
   return r;
@@ -82,10 +84,12 @@ IndexPairs rpePairs(const Trajectory& traj, double delta, DeltaUnit unit, bool a
     }
     return pairs;
   }
-  if (!(delta > 0) || !std::isfinite(delta)) throw InputError("RPE delta in metres must be > 0, got " + formatSeconds(delta));
+  if (!(delta > 0) || !std::isfinite(delta))
+    throw InputError("RPE delta in metres must be > 0, got " + formatSeconds(delta));
   if (all_pairs) {
     std::vector<double> travelled(n, 0.0);
-    for (std::size_t i = 1; i < n; ++i) travelled[i] = travelled[i - 1] + (traj[i].T_w_b.t - traj[i - 1].T_w_b.t).norm();
+    for (std::size_t i = 1; i < n; ++i)
+      travelled[i] = travelled[i - 1] + (traj[i].T_w_b.t - traj[i - 1].T_w_b.t).norm();
     const double tol = delta * rel_delta_tol;
     for (std::size_t i = 0; i + 1 < n; ++i) {
       const auto from_here = [&](std::size_t k) { return travelled[k] - travelled[i]; };
@@ -115,8 +119,9 @@ RpeResult computeRpe(const Trajectory& ref, const Trajectory& est, const RpeOpti
   const Trajectory& pairing = options.pairs_from_reference ? r.data.ref : r.data.est;
   r.pairs = rpePairs(pairing, options.delta, options.unit, options.all_pairs, options.rel_delta_tol);
   if (r.pairs.empty()) {
-    throw InputError("RPE: delta " + formatSeconds(options.delta) + (options.unit == DeltaUnit::Frames ? " frames" : " m") +
-                     " gives no pair of poses among the " + std::to_string(pairing.size()) + " associated poses of " +
+    throw InputError("RPE: delta " + formatSeconds(options.delta) +
+                     (options.unit == DeltaUnit::Frames ? " frames" : " m") + " gives no pair of poses among the " +
+                     std::to_string(pairing.size()) + " associated poses of " +
                      (options.pairs_from_reference ? options.eval.reference_name : options.eval.estimate_name) +
                      "; try a smaller delta");
   }

@@ -21,9 +21,9 @@ using plot::Align;
 struct View {
   int h = 0, v = 2;  // world axes shown horizontally and vertically
   cv::Rect area;
-  double scale = 1;           // pixels per metre
-  double h0 = 0, v0 = 0;      // world coordinates at the area's left and bottom edges
-  double h1 = 0, v1 = 0;      // ... right and top edges
+  double scale = 1;       // pixels per metre
+  double h0 = 0, v0 = 0;  // world coordinates at the area's left and bottom edges
+  double h1 = 0, v1 = 0;  // ... right and top edges
   cv::Point2d px(const Vec3& p) const {
     return {area.x + (p[h] - h0) * scale, area.y + area.height - (p[v] - v0) * scale};
   }

@@ -153,7 +153,8 @@ bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spac
   for (; k < t.padded; ++k) t.value[k] = t.dx[k] = t.dy[k] = 0;
   const double n = t.samples;
   const float mean_v = static_cast<float>(sum(t.value, t.padded) / n);
-  const float mean_x = static_cast<float>(sum(t.dx, t.padded) / n), mean_y = static_cast<float>(sum(t.dy, t.padded) / n);
+  const float mean_x = static_cast<float>(sum(t.dx, t.padded) / n),
+              mean_y = static_cast<float>(sum(t.dy, t.padded) / n);
   for (k = 0; k < t.samples; ++k) {
     t.value[k] -= mean_v;
     t.dx[k] -= mean_x;
@@ -235,13 +236,14 @@ enum class ShiftOutcome { Converged, NotConverged, NoTexture, TooFar };
 
 // The shift along the direction that aligns the partner's patch to the template (ZNCC residual), from 0.
 ShiftOutcome iterateShift(const AlignmentTemplate& t, const PartnerWarp& pw, const ImageView& image, const Vec2& uv0,
-                          const Vec2& direction, double max_shift, const EpipolarAlignmentOptions& options,
-                          double& s, double& zncc, double& residual2) {
+                          const Vec2& direction, double max_shift, const EpipolarAlignmentOptions& options, double& s,
+                          double& zncc, double& residual2) {
   const int n = t.samples, padded = t.padded;
   alignas(16) float xs[kMaxPadded], ys[kMaxPadded], values[kMaxPadded];
   double previous_s = 0, previous_b = 0;
   for (int it = 0; it < options.max_iterations; ++it) {
-    const float cx = static_cast<float>(uv0.x() + s * direction.x()), cy = static_cast<float>(uv0.y() + s * direction.y());
+    const float cx = static_cast<float>(uv0.x() + s * direction.x()),
+                cy = static_cast<float>(uv0.y() + s * direction.y());
     for (int k = 0; k < padded; ++k) {
       xs[k] = cx + pw.off_x[k];
       ys[k] = cy + pw.off_y[k];

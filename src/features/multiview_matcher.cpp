@@ -40,7 +40,9 @@ void MultiViewMatcher::prepareCamera(FrameFeatures& f, int camera) {
   pairs_.prepareCamera(rig_, f, camera);
 }
 
-void MultiViewMatcher::matchPair(const FrameFeatures& f, int pair, int thread) { pairs_.matchPair(rig_, f, pair, thread); }
+void MultiViewMatcher::matchPair(const FrameFeatures& f, int pair, int thread) {
+  pairs_.matchPair(rig_, f, pair, thread);
+}
 
 void MultiViewMatcher::finishFrame(FrameFeatures& f) {
   mergeFrame(f);

@@ -19,8 +19,8 @@ inline uint8_t blurTaps(int c, int a1, int b1, int a2, int b2, int a3, int b3) {
 }
 
 // src (w x h) -> dst through tmp (horizontal pass, then vertical); borders clamped.
-inline void blur7(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stride, uint8_t* tmp, int tmp_stride,
-                  int w, int h) {
+inline void blur7(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stride, uint8_t* tmp, int tmp_stride, int w,
+                  int h) {
   // Horizontal pass into tmp: the interior in 16-bit lanes (the sum fits), the 3-pixel borders clamped.
   for (int y = 0; y < h; ++y) {
     const uint8_t* s = src + static_cast<long>(y) * src_stride;
@@ -31,9 +31,9 @@ inline void blur7(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stri
     for (int x = 0; x < left_end; ++x)
       t[x] = blurTaps(at(x), at(x - 1), at(x + 1), at(x - 2), at(x + 2), at(x - 3), at(x + 3));
     for (int x = 3; x < interior_end; ++x) {
-      const uint16_t v = static_cast<uint16_t>(
-          kTap0 * s[x] + kTap1 * static_cast<uint16_t>(s[x - 1] + s[x + 1]) +
-          kTap2 * static_cast<uint16_t>(s[x - 2] + s[x + 2]) + kTap3 * static_cast<uint16_t>(s[x - 3] + s[x + 3]) + 128);
+      const uint16_t v = static_cast<uint16_t>(kTap0 * s[x] + kTap1 * static_cast<uint16_t>(s[x - 1] + s[x + 1]) +
+                                               kTap2 * static_cast<uint16_t>(s[x - 2] + s[x + 2]) +
+                                               kTap3 * static_cast<uint16_t>(s[x - 3] + s[x + 3]) + 128);
       t[x] = static_cast<uint8_t>(v >> 8);
     }
     for (int x = interior_end; x < w; ++x)
@@ -45,9 +45,9 @@ inline void blur7(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stri
     for (int k = 0; k < 7; ++k) r[k] = tmp + static_cast<long>(clampTo(y + k - 3, 0, h - 1)) * tmp_stride;
     uint8_t* d = dst + static_cast<long>(y) * dst_stride;
     for (int x = 0; x < w; ++x) {
-      const uint16_t v = static_cast<uint16_t>(
-          kTap0 * r[3][x] + kTap1 * static_cast<uint16_t>(r[2][x] + r[4][x]) +
-          kTap2 * static_cast<uint16_t>(r[1][x] + r[5][x]) + kTap3 * static_cast<uint16_t>(r[0][x] + r[6][x]) + 128);
+      const uint16_t v = static_cast<uint16_t>(kTap0 * r[3][x] + kTap1 * static_cast<uint16_t>(r[2][x] + r[4][x]) +
+                                               kTap2 * static_cast<uint16_t>(r[1][x] + r[5][x]) +
+                                               kTap3 * static_cast<uint16_t>(r[0][x] + r[6][x]) + 128);
       d[x] = static_cast<uint8_t>(v >> 8);
     }
   }

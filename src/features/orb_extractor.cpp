@@ -213,8 +213,8 @@ OrbStatus OrbExtractor::extract(const ImageView& image, FeatureSet& out) {
       if (w <= 2 * s.options.edge_margin || h <= 2 * s.options.edge_margin) break;
       const Plane previous = current;
       current = s.plane(previous.data == s.level_a.data() ? s.level_b : s.level_a, w, h);
-      downscale(previous, current, s.options.scale_factor, {s.src_x.data(), s.resample_weights.data(), s.resample_row.data()},
-                s.options.use_simd);
+      downscale(previous, current, s.options.scale_factor,
+                {s.src_x.data(), s.resample_weights.data(), s.resample_row.data()}, s.options.use_simd);
     }
     const int budget = s.budgets[static_cast<size_t>(level)] + carry;
     carry = budget - s.extractLevel(level, current, budget, out);

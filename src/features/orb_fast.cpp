@@ -25,7 +25,8 @@ bool fastHasWideSimd() {
 int fastScoreRow(const uint8_t* image, int stride, int y, int x0, int x1, int threshold, uint8_t* out,
                  FastBackend backend) {
 #if defined(MCSLAM_ORB_HAVE_AVX2_UNIT)
-  if (backend == FastBackend::kWide && fastHasWideSimd()) return fastScoreRowAvx2(image, stride, y, x0, x1, threshold, out);
+  if (backend == FastBackend::kWide && fastHasWideSimd())
+    return fastScoreRowAvx2(image, stride, y, x0, x1, threshold, out);
 #endif
 #if defined(MCSLAM_ORB_HAVE_NATIVE)
   if (backend != FastBackend::kScalar) return scoreRow<NativeU8x16>(image, stride, y, x0, x1, threshold, out);

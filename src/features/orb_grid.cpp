@@ -24,8 +24,8 @@ void collectScalar(const ConstPlane& scores, const Rect& rect, std::vector<Corne
         const uint8_t* p = row + x + i;
         const int s = *p;
         if (s == 0) continue;
-        const bool is_max = s >= p[-stride - 1] && s >= p[-stride] && s >= p[-stride + 1] && s >= p[-1] &&
-                            s > p[1] && s > p[stride - 1] && s > p[stride] && s > p[stride + 1];
+        const bool is_max = s >= p[-stride - 1] && s >= p[-stride] && s >= p[-stride + 1] && s >= p[-1] && s > p[1] &&
+                            s > p[stride - 1] && s > p[stride] && s > p[stride + 1];
         if (is_max && out.size() < out.capacity()) out.push_back({x + i, y, static_cast<float>(s)});
       }
     }
@@ -49,8 +49,8 @@ void collectSse2(const ConstPlane& scores, const Rect& rect, std::vector<Corner>
       const int lanes = n == 16 ? 0xFFFF : (1 << n) - 1;
       const int live = ~_mm_movemask_epi8(_mm_cmpeq_epi8(s, zero)) & lanes;
       if (live == 0) continue;
-      const __m128i before = _mm_max_epu8(_mm_max_epu8(load(up + x - 1), load(up + x)),
-                                          _mm_max_epu8(load(up + x + 1), load(row + x - 1)));
+      const __m128i before =
+          _mm_max_epu8(_mm_max_epu8(load(up + x - 1), load(up + x)), _mm_max_epu8(load(up + x + 1), load(row + x - 1)));
       const __m128i after = _mm_max_epu8(_mm_max_epu8(load(down + x - 1), load(down + x)),
                                          _mm_max_epu8(load(down + x + 1), load(row + x + 1)));
       const int not_below = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(s, before), s));

@@ -32,7 +32,8 @@ void resampleRow(const int16_t* row, const DownscaleScratch& scratch, int width,
   auto gather4 = [&](int i) {
     uint32_t p[4];
     for (int k = 0; k < 4; ++k) std::memcpy(&p[k], row + scratch.src_x[i + k], sizeof(uint32_t));
-    return _mm_set_epi32(static_cast<int>(p[3]), static_cast<int>(p[2]), static_cast<int>(p[1]), static_cast<int>(p[0]));
+    return _mm_set_epi32(static_cast<int>(p[3]), static_cast<int>(p[2]), static_cast<int>(p[1]),
+                         static_cast<int>(p[0]));
   };
   const __m128i round = _mm_set1_epi32(static_cast<int>(kRound));
   for (; use_simd && x + 8 <= width; x += 8) {
@@ -69,7 +70,8 @@ void downscale(const ConstPlane& src, const Plane& dst, float ratio, const Downs
     const uint8_t* a = src.row(y0);
     const uint8_t* b = src.row(std::min(y0 + 1, last_y));
     // Vertical first (contiguous, vectorizes), 6 fractional bits kept.
-    for (int x = 0; x < src.width; ++x) row[x] = static_cast<int16_t>(static_cast<uint16_t>(a[x] * gy + b[x] * fy + 2) >> 2);
+    for (int x = 0; x < src.width; ++x)
+      row[x] = static_cast<int16_t>(static_cast<uint16_t>(a[x] * gy + b[x] * fy + 2) >> 2);
     row[src.width] = row[src.width - 1];  // a one-column source reads its pair's second value here
     resampleRow(row, scratch, dst.width, dst.row(y), use_simd);
   }

@@ -21,9 +21,9 @@ struct ConstPlane {
 
 // Scratch for downscale(): column tables and one intermediate row, each at least the source width.
 struct DownscaleScratch {
-  int32_t* src_x;      // left source column of each destination column
-  uint32_t* weights;   // its weights (left | right << 16), 1/256 units
-  int16_t* row;        // vertically interpolated source row (width + 1)
+  int32_t* src_x;     // left source column of each destination column
+  uint32_t* weights;  // its weights (left | right << 16), 1/256 units
+  int16_t* row;       // vertically interpolated source row (width + 1)
 };
 
 // Bilinear resampling where destination pixel x samples source (x + 0.5) * ratio - 0.5 (pixel centres

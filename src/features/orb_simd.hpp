@@ -66,14 +66,10 @@ struct NativeU8x16 {
   static constexpr int kLanes = 16;
   __m128i v;
 
-  static NativeU8x16 load(const uint8_t* p) {
-    return {_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))};
-  }
+  static NativeU8x16 load(const uint8_t* p) { return {_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))}; }
   static NativeU8x16 splat(uint8_t x) { return {_mm_set1_epi8(static_cast<char>(x))}; }
   void store(uint8_t* p) const { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v); }
-  bool anyNonZero() const {
-    return _mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_setzero_si128())) != 0xFFFF;
-  }
+  bool anyNonZero() const { return _mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_setzero_si128())) != 0xFFFF; }
   friend NativeU8x16 min(NativeU8x16 a, NativeU8x16 b) { return {_mm_min_epu8(a.v, b.v)}; }
   friend NativeU8x16 max(NativeU8x16 a, NativeU8x16 b) { return {_mm_max_epu8(a.v, b.v)}; }
   friend NativeU8x16 subs(NativeU8x16 a, NativeU8x16 b) { return {_mm_subs_epu8(a.v, b.v)}; }
@@ -97,9 +93,7 @@ struct NativeU8x16 {
   friend NativeU8x16 max(NativeU8x16 a, NativeU8x16 b) { return {vmaxq_u8(a.v, b.v)}; }
   friend NativeU8x16 subs(NativeU8x16 a, NativeU8x16 b) { return {vqsubq_u8(a.v, b.v)}; }
   friend NativeU8x16 adds(NativeU8x16 a, NativeU8x16 b) { return {vqaddq_u8(a.v, b.v)}; }
-  friend NativeU8x16 keepAbove(NativeU8x16 a, NativeU8x16 t) {
-    return {vandq_u8(a.v, vcgtq_u8(a.v, t.v))};
-  }
+  friend NativeU8x16 keepAbove(NativeU8x16 a, NativeU8x16 t) { return {vandq_u8(a.v, vcgtq_u8(a.v, t.v))}; }
 };
 #define MCSLAM_ORB_HAVE_NATIVE 1
 #endif

@@ -50,7 +50,8 @@ void SpacedSelector::sortByScore(std::span<const Corner> corners) {
   int start[kScoreLevels + 1] = {};
   for (int i = 0; i < n; ++i) ++start[kScoreLevels - static_cast<int>(corners[i].score)];  // descending
   for (int k = 0; k < kScoreLevels; ++k) start[k + 1] += start[k];
-  for (int i = 0; i < n; ++i) order_[static_cast<size_t>(start[kScoreLevels - 1 - static_cast<int>(corners[i].score)]++)] = i;
+  for (int i = 0; i < n; ++i)
+    order_[static_cast<size_t>(start[kScoreLevels - 1 - static_cast<int>(corners[i].score)]++)] = i;
 }
 
 int SpacedSelector::select(std::span<const Corner> corners, const Rect& region, float spacing, int budget,

@@ -50,8 +50,10 @@ bool clipSegment(Vec2& a, Vec2& b, const Vec2& lo, const Vec2& hi) {
       continue;
     }
     const double r = q[k] / p[k];
-    if (p[k] < 0.0) t0 = std::max(t0, r);
-    else t1 = std::min(t1, r);
+    if (p[k] < 0.0)
+      t0 = std::max(t0, r);
+    else
+      t1 = std::min(t1, r);
     if (t0 > t1) return false;
   }
   const Vec2 a0 = a;
@@ -113,8 +115,10 @@ void OverlapMap::computePair(const Rig& rig, int i, int j) {
             have_prev = false;
             continue;
           }
-          if (have_prev) markSegment(gj, prev, uv, hit);
-          else if (const int c = gj.cellOf(uv.x(), uv.y()); c >= 0) hit[c] = 1;
+          if (have_prev)
+            markSegment(gj, prev, uv, hit);
+          else if (const int c = gj.cellOf(uv.x(), uv.y()); c >= 0)
+            hit[c] = 1;
           prev = uv;
           have_prev = true;
         }

@@ -146,8 +146,8 @@ int PairMatcher::matchCameras(const Rig& rig, const FrameFeatures& f, int i, int
       if (candidates == 0) continue;
       const int best = bestOfCandidates(f, i, j, a, candidates, sc);
       if (best < 0) continue;
-      out[count++] = PairMatch{static_cast<int16_t>(i), static_cast<int16_t>(j), a, sc.candidate_b[best],
-                               sc.candidate_dist[best]};
+      out[count++] =
+          PairMatch{static_cast<int16_t>(i), static_cast<int16_t>(j), a, sc.candidate_b[best], sc.candidate_dist[best]};
     }
   }
   // Keep only mutual best matches that pass the ratio test both ways: b's best keypoint of camera i must be a,
@@ -157,7 +157,8 @@ int PairMatcher::matchCameras(const Rig& rig, const FrameFeatures& f, int i, int
   int kept = 0;
   for (int m = 0; m < count; ++m) {
     const int b = out[m].kp_b;
-    if (sc.best_for_b[b] == out[m].kp_a && passesRatioTest(sc.best_dist_for_b[b], sc.second_dist_for_b[b], options_.ratio)) {
+    if (sc.best_for_b[b] == out[m].kp_a &&
+        passesRatioTest(sc.best_dist_for_b[b], sc.second_dist_for_b[b], options_.ratio)) {
       out[kept++] = out[m];
     }
   }
@@ -196,8 +197,12 @@ void PairMatcher::arrangeCandidates(const FrameFeatures& f, int j, PairScratch& 
     const int b = sc.sorted_b[k];
     const Vec3& d = dir_b_[j][b];
     sc.sorted_angle[k] = sc.plane_angle[b];
-    sc.sorted_candidates[k] = Candidate{sc.plane_angle[b], b, cell_of_[j][b], sj.keypoints[b].octave,
-                                      {static_cast<float>(d.x()), static_cast<float>(d.y()), static_cast<float>(d.z())}};
+    sc.sorted_candidates[k] =
+        Candidate{sc.plane_angle[b],
+                  b,
+                  cell_of_[j][b],
+                  sj.keypoints[b].octave,
+                  {static_cast<float>(d.x()), static_cast<float>(d.y()), static_cast<float>(d.z())}};
   }
   // Half-width of the angle window per octave of the keypoint in j: |n . d| = sine * |sin(angle difference)|.
   for (int o = 0; o < kMaxOctaves; ++o) {

@@ -63,7 +63,9 @@ void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, 
   int32_t* nodes = members_.data() + track_first_[t];
   Member* obs = aligned_obs_.data() + track_first_[t];
   int size = track_size_[t];
-  auto keypointOf = [&](int s) -> const Keypoint& { return f.sets[nodes[s] / capacity_].keypoints[nodes[s] % capacity_]; };
+  auto keypointOf = [&](int s) -> const Keypoint& {
+    return f.sets[nodes[s] / capacity_].keypoints[nodes[s] % capacity_];
+  };
   int ref = 0;
   for (int s = 0; s < size; ++s) {
     const Keypoint& kp = keypointOf(s);
@@ -143,8 +145,8 @@ bool TrackBuilder::makeReference(const Rig& rig, const KeypointBearings& bearing
 // reference ray; rho = 0 is the point at infinity), the start is the partner keypoint projected onto it, and
 // the patch warp is the derivative of the reference pixel -> partner pixel map there. ref: the track's
 // reference patch and the pseudo-inverse of its projection's Jacobian at the unit bearing. Fills `out` when Ok.
-AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* images, const FrameFeatures& f, int ref_node,
-                                           int node, const ReferencePatch& ref, Member& out) const {
+AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* images, const FrameFeatures& f,
+                                           int ref_node, int node, const ReferencePatch& ref, Member& out) const {
   const int r_cam = ref_node / capacity_;
   const int p_cam = node / capacity_, p_index = node % capacity_;
   const ImageView& image = images[p_cam];
@@ -190,7 +192,8 @@ AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* imag
   // reference projection's Jacobian at the unit bearing; the range cancels against the partner's Jacobian at Y).
   const Mat2 A = J * (R_p_b * T_b_r.R) * ref.J_pinv;
   const double g_norm = g.norm();
-  const EpipolarAlignment a = alignAlongEpipolar(ref.patch, image, uv, g / g_norm, A, sigma_[kp.octave], options_.alignment);
+  const EpipolarAlignment a =
+      alignAlongEpipolar(ref.patch, image, uv, g / g_norm, A, sigma_[kp.octave], options_.alignment);
   if (a.ok()) {
     // The aligned point lies on the curve: its bearing is the curve's at the shifted inverse range.
     out.uv = a.uv;

@@ -129,7 +129,8 @@ void TrackBuilder::emitTracks(const Rig& rig, FrameFeatures& f) {
     } else {
       for (int s = 0; s < track_size_[t]; ++s) {
         const Keypoint& kp = f.sets[nodes[s] / capacity_].keypoints[nodes[s] % capacity_];
-        obs[s] = Member{Vec2(kp.x, kp.y), f.bearings[nodes[s] / capacity_][nodes[s] % capacity_], sigma_[kp.octave], false};
+        obs[s] =
+            Member{Vec2(kp.x, kp.y), f.bearings[nodes[s] / capacity_][nodes[s] % capacity_], sigma_[kp.octave], false};
       }
       solution = solveTrack(rig, f, nodes, obs, track_size_[t]);
     }
@@ -208,9 +209,11 @@ bool TrackBuilder::hiddenFromNearerCamera(const Rig& rig, const FrameFeatures& f
   const double baseline = (rig.T_b_c(c0).t - rig.T_b_c(c1).t).norm();
   for (int c = 0; c < f.cameras(); ++c) {
     if (c == c0 || c == c1 || !f.present[c]) continue;
-    const double nearer = std::min((rig.T_b_c(c).t - rig.T_b_c(c0).t).norm(), (rig.T_b_c(c).t - rig.T_b_c(c1).t).norm());
+    const double nearer =
+        std::min((rig.T_b_c(c).t - rig.T_b_c(c0).t).norm(), (rig.T_b_c(c).t - rig.T_b_c(c1).t).norm());
     if (!(nearer < 0.9 * baseline)) continue;
-    if (!(overlap_.overlaps(c, c0) || overlap_.overlaps(c0, c) || overlap_.overlaps(c, c1) || overlap_.overlaps(c1, c))) {
+    if (!(overlap_.overlaps(c, c0) || overlap_.overlaps(c0, c) || overlap_.overlaps(c, c1) ||
+          overlap_.overlaps(c1, c))) {
       continue;
     }
     const CameraModel& model = rig.model(c);
@@ -234,7 +237,8 @@ int16_t TrackBuilder::medoidOf(const FrameFeatures& f, const int32_t* nodes, int
   for (int a = 0; a < size; ++a) {
     const Descriptor& da = f.sets[nodes[a] / capacity_].descriptors[nodes[a] % capacity_];
     int sum = 0;
-    for (int b = 0; b < size; ++b) sum += hammingDistance(da, f.sets[nodes[b] / capacity_].descriptors[nodes[b] % capacity_]);
+    for (int b = 0; b < size; ++b)
+      sum += hammingDistance(da, f.sets[nodes[b] / capacity_].descriptors[nodes[b] % capacity_]);
     if (sum < best_sum) {
       best_sum = sum;
       medoid = static_cast<int16_t>(a);

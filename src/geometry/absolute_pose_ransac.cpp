@@ -54,7 +54,8 @@ double AbsolutePoseRansac::score(std::span<const PoseObservation> obs, const SE3
       // many wrong hypotheses). cos(a) >= 1 - a^2 / 2 keeps the test conservative.
       const Vec3 v = T_b_w * o.point_w - o.ray.origin;
       const double max_angle = threshold_sigmas * o.sigma_px * rig_.maxRadiansPerPixel(o.camera);
-      const bool near_ray = max_angle >= 1.0 || v.dot(o.ray.direction) >= (1.0 - 0.5 * max_angle * max_angle) * v.norm();
+      const bool near_ray =
+          max_angle >= 1.0 || v.dot(o.ray.direction) >= (1.0 - 0.5 * max_angle * max_angle) * v.norm();
       Vec2 uv;
       if (near_ray && rig_.model(o.camera).project(T_c_w_[o.camera] * o.point_w, uv)) {
         s = std::min(cap, (uv - o.pixel).squaredNorm() / (o.sigma_px * o.sigma_px));

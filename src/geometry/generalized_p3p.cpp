@@ -92,7 +92,7 @@ bool polishDepths(const PairConstraint& f12, const PairConstraint& f13, const Pa
     const Vec3 F(f12(l[0], l[1]), f13(l[0], l[2]), f23(l[1], l[2]));
     Mat3 J;
     J << 2 * l[0] + f12.a * l[1] + f12.b, 2 * l[1] + f12.a * l[0] + f12.c, 0,  //
-        2 * l[0] + f13.a * l[2] + f13.b, 0, 2 * l[2] + f13.a * l[0] + f13.c,  //
+        2 * l[0] + f13.a * l[2] + f13.b, 0, 2 * l[2] + f13.a * l[0] + f13.c,   //
         0, 2 * l[1] + f23.a * l[2] + f23.b, 2 * l[2] + f23.a * l[1] + f23.c;
     const double det = J.determinant();
     if (!std::isfinite(det) || std::abs(det) < 1e-300) return F.norm() < 1e-12 * (1 + l.squaredNorm());

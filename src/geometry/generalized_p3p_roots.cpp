@@ -49,7 +49,9 @@ double rootInBracket(const double* a, int n, double lo, double hi, double p_lo) 
     if (!(next > lo && next < hi) || std::abs(next - x) > 0.5 * step_before) next = 0.5 * (lo + hi);
     step_before = std::abs(next - x);
     x = next;
-    if (hi - lo <= kRootTolerance * std::max(1.0, std::abs(x)) || step_before <= 0.01 * kRootTolerance * std::max(1.0, std::abs(x))) break;
+    if (hi - lo <= kRootTolerance * std::max(1.0, std::abs(x)) ||
+        step_before <= 0.01 * kRootTolerance * std::max(1.0, std::abs(x)))
+      break;
   }
   return x;
 }

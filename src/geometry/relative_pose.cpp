@@ -113,7 +113,9 @@ Refined refineHypothesis(const Valid& v, const SE3& start, bool central, const R
   return r;
 }
 
-bool better(const Refined& a, const Refined& b) { return a.inliers > b.inliers || (a.inliers == b.inliers && a.cost < b.cost); }
+bool better(const Refined& a, const Refined& b) {
+  return a.inliers > b.inliers || (a.inliers == b.inliers && a.cost < b.cost);
+}
 
 // Inliers, observability and status of the chosen pose, shared by both cases.
 void finish(const Valid& v, const Refined& best, bool central, const RelativePoseOptions& o, size_t num_matches,
@@ -208,7 +210,8 @@ bool rotationFirstHypothesis(const Rig& rig, std::span<const RelativeCorresponde
   std::vector<uint8_t> mask;
   const int tries = std::min<int>(static_cast<int>(candidates.size()), 300);
   for (int k = 0; k < tries; ++k) {
-    const double s = candidates.size() <= 300 ? candidates[k] : candidates[random.below(static_cast<int>(candidates.size()))];
+    const double s =
+        candidates.size() <= 300 ? candidates[k] : candidates[random.below(static_cast<int>(candidates.size()))];
     const int inl = selectInliers(v.rays, SE3(R, t0 + s * dir), inlierAngle(o), mask);
     if (inl > best_inliers) {
       best_inliers = inl;

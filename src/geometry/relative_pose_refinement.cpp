@@ -260,7 +260,7 @@ Observability analyzeObservability(std::span<const RayPair> matches, std::span<c
     const double max_ev = std::max(er.eigenvalues().maxCoeff(), Hkk.diagonal().maxCoeff());
     if (!(er.eigenvalues().minCoeff() > 1e-10 * max_ev)) return false;
     const Eigen::MatrixXd S = Hkk - Hkr * er.eigenvectors() * er.eigenvalues().cwiseInverse().asDiagonal() *
-                                       er.eigenvectors().transpose() * Hkr.transpose();
+                                        er.eigenvectors().transpose() * Hkr.transpose();
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(S);
     if (!(es.eigenvalues().minCoeff() > 1e-10 * max_ev)) return false;
     cov = es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() * es.eigenvectors().transpose();
@@ -278,7 +278,8 @@ Observability analyzeObservability(std::span<const RayPair> matches, std::span<c
   const Eigen::MatrixXd H6 = Hq;
   if (marginalCovariance(H6, 0, 1, cov)) out.relative_scale_sigma = std::sqrt(cov(0, 0)) / tn;
   if (marginalCovariance(H6, 1, 2, cov)) {
-    out.direction_sigma_rad = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(cov).eigenvalues().maxCoeff()) / tn;
+    out.direction_sigma_rad =
+        std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(cov).eigenvalues().maxCoeff()) / tn;
   }
   return out;
 }

@@ -65,7 +65,8 @@ bool buildSystem(const TriangulationObservation* obs, int n, const Vec3& p, Mat3
 
 bool depthKnown(const TriangulationResult& r, const TriangulationOptions& o) {
   if (!(o.reference_inverse_depth > 0)) return r.relative_depth_sigma <= o.max_relative_depth_sigma;
-  return r.inverse_depth_sigma <= o.max_relative_depth_sigma * o.reference_inverse_depth && r.relative_depth_sigma <= 1.0;
+  return r.inverse_depth_sigma <= o.max_relative_depth_sigma * o.reference_inverse_depth &&
+         r.relative_depth_sigma <= 1.0;
 }
 
 }  // namespace
@@ -134,10 +135,14 @@ TriangulationResult triangulate(const TriangulationObservation* obs, int n, cons
     }
   }
   res.max_parallax_deg = std::acos(std::clamp(max_cos, -1.0, 1.0)) * 180.0 / M_PI;
-  if (max_err > options.max_reprojection_sigmas) res.status = TriangulationStatus::LargeReprojection;
-  else if (res.max_parallax_deg < options.min_parallax_deg) res.status = TriangulationStatus::LowParallax;
-  else if (!depthKnown(res, options)) res.status = TriangulationStatus::Uncertain;
-  else res.status = TriangulationStatus::Ok;
+  if (max_err > options.max_reprojection_sigmas)
+    res.status = TriangulationStatus::LargeReprojection;
+  else if (res.max_parallax_deg < options.min_parallax_deg)
+    res.status = TriangulationStatus::LowParallax;
+  else if (!depthKnown(res, options))
+    res.status = TriangulationStatus::Uncertain;
+  else
+    res.status = TriangulationStatus::Ok;
   return res;
 }
 

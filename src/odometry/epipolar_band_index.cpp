@@ -29,7 +29,8 @@ bool EpipolarBandIndex::begin(const Vec3& axis) {
 void EpipolarBandIndex::add(int32_t id, const Vec3& bearing, int octave) {
   if (added_count_ + near_count_ >= static_cast<int>(added_.size())) return;  // capacity: the caller's bound
   octave = std::clamp(octave, 0, octaves_ - 1);
-  const Entry e{{static_cast<float>(bearing.x()), static_cast<float>(bearing.y()), static_cast<float>(bearing.z())}, id};
+  const Entry e{{static_cast<float>(bearing.x()), static_cast<float>(bearing.y()), static_cast<float>(bearing.z())},
+                id};
   const double x = u_.dot(bearing), y = v_.dot(bearing);
   const double sine = std::sqrt(x * x + y * y);
   if (sine < kNearAxisSine) {

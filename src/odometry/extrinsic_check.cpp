@@ -41,8 +41,8 @@ ExtrinsicCheck::~ExtrinsicCheck() = default;
 
 void ExtrinsicCheck::reset() { std::fill(sample_count_.begin(), sample_count_.end(), 0); }
 
-int ExtrinsicCheck::check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
-                          const SE3& T_w_b, SE3& T_b_c) {
+int ExtrinsicCheck::check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
+                          const FrameMatches& matches, const SE3& T_w_b, SE3& T_b_c) {
   const int cam = suspectCamera(frame, matches);
   if (cam < 0) return -1;
   Sample s;
@@ -82,8 +82,8 @@ int ExtrinsicCheck::suspectCamera(const FrameFeatures& frame, const FrameMatches
   return suspect;
 }
 
-bool ExtrinsicCheck::sample(int cam, const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
-                            const SE3& T_w_b, Sample& out) {
+bool ExtrinsicCheck::sample(int cam, const Map& map, ProjectionSearch& search, const Rig& rig,
+                            const FrameFeatures& frame, const SE3& T_w_b, Sample& out) {
   // The local map into this camera alone, with the tracking's wide window (its second attempt's radius).
   ProjectionSearchParams p;
   p.max_hamming = options_.max_hamming;
@@ -154,9 +154,10 @@ bool ExtrinsicCheck::decide(int cam, const Rig& rig, SE3& T_b_c) {
   const double shift = pixelShift(model, current, candidate, depth);
   if (!(shift > gate_px_)) return false;
   const SE3 change = current.inverse() * candidate;
-  spdlog::info("odometry: camera {} extrinsic re-estimated from {} frames: moved {:.1f} mm, {:.2f} deg "
-               "({:.1f} px at {:.1f} m; the frames agree to {:.2f} px)",
-               cam, kSamples, change.t.norm() * 1e3, so3Log(change.R).norm() * 180.0 / M_PI, shift, depth, spread);
+  spdlog::info(
+      "odometry: camera {} extrinsic re-estimated from {} frames: moved {:.1f} mm, {:.2f} deg "
+      "({:.1f} px at {:.1f} m; the frames agree to {:.2f} px)",
+      cam, kSamples, change.t.norm() * 1e3, so3Log(change.R).norm() * 180.0 / M_PI, shift, depth, spread);
   T_b_c = candidate;
   sample_count_[cam] = 0;
   return true;
@@ -165,8 +166,8 @@ bool ExtrinsicCheck::decide(int cam, const Rig& rig, SE3& T_b_c) {
 double ExtrinsicCheck::pixelShift(const CameraModel& model, const SE3& a, const SE3& b, double depth) const {
   const SE3 T_b_a = b.inverse() * a;
   const double w = model.width(), h = model.height();
-  const Vec2 probes[5] = {{0.5 * w, 0.5 * h}, {0.25 * w, 0.25 * h}, {0.75 * w, 0.25 * h},
-                          {0.25 * w, 0.75 * h}, {0.75 * w, 0.75 * h}};
+  const Vec2 probes[5] = {
+      {0.5 * w, 0.5 * h}, {0.25 * w, 0.25 * h}, {0.75 * w, 0.25 * h}, {0.25 * w, 0.75 * h}, {0.75 * w, 0.75 * h}};
   double sum = 0;
   for (const Vec2& uv : probes) {
     Vec3 bearing;

@@ -26,8 +26,8 @@ class ExtrinsicCheck {
   // After frame `frame` was tracked at T_w_b with inlier matches `matches` (`search` prepared for the frame),
   // with the current extrinsics `rig` (a view for the call). Returns the camera whose extrinsic estimate should
   // become T_b_c, or -1.
-  int check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame, const FrameMatches& matches,
-            const SE3& T_w_b, SE3& T_b_c);
+  int check(const Map& map, ProjectionSearch& search, const Rig& rig, const FrameFeatures& frame,
+            const FrameMatches& matches, const SE3& T_w_b, SE3& T_b_c);
   void reset();  // the map was dropped: its samples with it
 
   // Frames whose implied extrinsics must agree before one is adopted.

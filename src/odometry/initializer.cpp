@@ -15,7 +15,8 @@ Initializer::Initializer(const Rig& rig, const OdometryOptions& options, int max
 
 int Initializer::usableMultiView(const FrameFeatures& f, double max_depth_sigma) {
   int n = 0;
-  for (int t = 0; t < f.mv_count; ++t) n += f.mv[t].has_point && f.mv[t].relative_depth_sigma <= max_depth_sigma ? 1 : 0;
+  for (int t = 0; t < f.mv_count; ++t)
+    n += f.mv[t].has_point && f.mv[t].relative_depth_sigma <= max_depth_sigma ? 1 : 0;
   return n;
 }
 
@@ -55,7 +56,8 @@ int Initializer::matchToReference(const FrameFeatures& f) {
           second = d;
         }
       }
-      if (best_r < 0 || best > kMaxHamming || !passesRatioTest(best, second, kRatio) || best_of_ref_[best_r] != k) continue;
+      if (best_r < 0 || best > kMaxHamming || !passesRatioTest(best, second, kRatio) || best_of_ref_[best_r] != k)
+        continue;
       if (!reference_.valid[c][best_r]) continue;
       RelativeCorrespondence m;
       m.camera1 = c;

@@ -6,7 +6,10 @@
 namespace mcslam {
 
 Map::Map(const Rig& rig, int max_features_per_camera, int max_keyframes, int max_landmarks)
-    : landmarks_(max_landmarks), free_landmarks_(max_landmarks), live_list_(max_landmarks), keyframes_(max_keyframes),
+    : landmarks_(max_landmarks),
+      free_landmarks_(max_landmarks),
+      live_list_(max_landmarks),
+      keyframes_(max_keyframes),
       medoid_scratch_(kMaxLandmarkObservations) {
   size_t n = 16;
   while (n < static_cast<size_t>(max_landmarks) * 2) n <<= 1;  // load factor at most 1/2

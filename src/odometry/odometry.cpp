@@ -29,8 +29,7 @@ constexpr int kMaxLostFrames = 5;
 }  // namespace
 
 Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
-    : options_(options),
-      map_(rig, max_features_per_camera, options.max_keyframes, options.max_landmarks) {
+    : options_(options), map_(rig, max_features_per_camera, options.max_keyframes, options.max_landmarks) {
   const int cams = rig.size();
   tracker_ = std::make_unique<Tracker>(rig, options_, max_features_per_camera);
   initializer_ = std::make_unique<Initializer>(rig, options_, max_features_per_camera);
@@ -78,7 +77,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   out.t = frame.t;
   out.sequence = frame_index;
   frame_index_ = frame_index;
-  flush();  // the previous keyframe's solve, before this frame reads the map
+  flush();                                // the previous keyframe's solve, before this frame reads the map
   tracker_->follow(bridge_->rigState());  // a frame boundary: tracking takes the rig state as it is now
   const auto start = Clock::now();
   const double flushed_ms = timing_.mapping_ms + timing_.backend_ms;
@@ -141,8 +140,8 @@ void Odometry::lose(uint64_t frame_index, int inliers, PoseEstimate& out) {
 void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers,
                             PoseEstimate& out) {
   const auto map_start = Clock::now();
-  const int slot = mapper_->insertKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, &tracker_->matches(), T_w_b,
-                                           frame_index);
+  const int slot = mapper_->insertKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, &tracker_->matches(),
+                                           T_w_b, frame_index);
   if (slot < 0) return;
   const int created = triangulateNew(slot);
   spdlog::trace("odometry: frame {}: keyframe, {} inliers, {} new landmarks", frame_index, inliers, created);
@@ -218,8 +217,8 @@ void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
 int Odometry::initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_index) {
   // Enough metric multi-view features: the map starts from this frame alone.
   resetMap();
-  const int kf_new = mapper_->insertKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, nullptr, anchor_,
-                                             frame_index);
+  const int kf_new =
+      mapper_->insertKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, nullptr, anchor_, frame_index);
   if (kf_new >= 0) bridge_->optimize(map_, kf_new);
   return kf_new;
 }

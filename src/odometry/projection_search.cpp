@@ -82,7 +82,8 @@ int ProjectionSearch::search(const Map& map, const Rig& rig, const int32_t* slot
       int predicted = 0;
       if (p.check_scale && l.max_distance > 0) {
         if (dist > 1.2 * l.max_distance || dist < 0.8 * l.min_distance) continue;
-        predicted = std::clamp(static_cast<int>(std::ceil(std::log(l.max_distance / dist) / log_scale)), 0, p.levels - 1);
+        predicted =
+            std::clamp(static_cast<int>(std::ceil(std::log(l.max_distance / dist) / log_scale)), 0, p.levels - 1);
       }
       visible = true;
       const double radius = p.radius_px * scales[predicted];

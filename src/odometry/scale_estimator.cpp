@@ -218,7 +218,7 @@ bool ScaleEstimator::reducedSystem(double& chi2, int& residuals) {
   const Eigen::LDLT<Reduced> exact(S_);
   scale_variance_ = exact.info() == Eigen::Success ? g_.dot(exact.solve(g_)) : INFINITY;
   if (!(scale_variance_ > 0)) scale_variance_ = INFINITY;  // singular or indefinite: the scale is not observed
-  if (hold_scale_) {  // a stiff prior keeps u where the profile put it
+  if (hold_scale_) {                                       // a stiff prior keeps u where the profile put it
     constexpr double kHoldWeight = 1e10;
     S_.noalias() += kHoldWeight * g_ * g_.transpose();
     b_.noalias() += kHoldWeight * (std::log(sum) - held_u_) * g_;

@@ -77,9 +77,11 @@ ScaleSupervisor::Rescale ScaleSupervisor::onKeyframe(const Map& map, const RigSt
   const double x = filter_->correction(), sigma = filter_->sigma();
   stats.combined_scale_sigma = sigma;
   // One line per estimate, for studies against ground truth (mcslam-run --log-level debug).
-  spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks, chi2/dof "
-                "{:.2f}), combined {:.4f} sigma {:.4f} over {:.0f} deg", frame_index, e.scale, e.relative_sigma,
-                e.keyframes, e.landmarks, e.reduced_chi2, std::exp(x), sigma, filter_->rotationSpan() * 180.0 / M_PI);
+  spdlog::debug(
+      "odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks, chi2/dof "
+      "{:.2f}), combined {:.4f} sigma {:.4f} over {:.0f} deg",
+      frame_index, e.scale, e.relative_sigma, e.keyframes, e.landmarks, e.reduced_chi2, std::exp(x), sigma,
+      filter_->rotationSpan() * 180.0 / M_PI);
   // A correction 3 sigma away from 1 is applied at any time: before convergence it brings the arbitrary unit near
   // the metric one (the windows' fits then start in the basin; far off, most windows give no estimate), the poses
   // staying flagged unscaled until the combined sigma reaches the bound.

@@ -17,8 +17,7 @@ constexpr int kMaxOctaveDifference = 2;
 
 }  // namespace
 
-TemporalTriangulator::TemporalTriangulator(const Rig& rig, const OdometryOptions& options,
-                                           int max_features_per_camera)
+TemporalTriangulator::TemporalTriangulator(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
     : options_(options),
       capacity_(max_features_per_camera),
       min_depth_(std::max(0.05, options.new_points.min_depth)),
@@ -89,7 +88,8 @@ int TemporalTriangulator::triangulate(Map& map, const Rig& rig, int slot) {
 int TemporalTriangulator::matchKeyframes(const Rig& rig, const Keyframe& kn, const Keyframe& ko) {
   const int cams = rig.size();
   int nc = 0;
-  for (int c = 0; c < cams; ++c) std::fill(claim_.begin() + c * capacity_, claim_.begin() + c * capacity_ + ko.features.sets[c].count, -1);
+  for (int c = 0; c < cams; ++c)
+    std::fill(claim_.begin() + c * capacity_, claim_.begin() + c * capacity_ + ko.features.sets[c].count, -1);
 
   for (int c2 = 0; c2 < cams; ++c2) {
     if (!kn.features.present[c2]) continue;
@@ -101,7 +101,8 @@ int TemporalTriangulator::matchKeyframes(const Rig& rig, const Keyframe& kn, con
     }
     for (int a = 0; a < set2.count; ++a) {
       const Best& best = best_[a];
-      if (best.kp < 0 || !best.free || best.distance > kMaxHamming || !passesRatioTest(best.distance, best.second, kRatio)) {
+      if (best.kp < 0 || !best.free || best.distance > kMaxHamming ||
+          !passesRatioTest(best.distance, best.second, kRatio)) {
         continue;
       }
       // One candidate per old keypoint: the closest descriptor wins.

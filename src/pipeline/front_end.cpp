@@ -11,7 +11,9 @@ std::vector<ImageSize> imageSizes(const Rig& rig) {
   return sizes;
 }
 using Clock = std::chrono::steady_clock;
-double msBetween(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+double msBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
 }  // namespace
 
 FrontEnd::FrontEnd(const Rig& rig, const PipelineConfig& config)
@@ -29,7 +31,8 @@ void FrontEnd::compute(const RigFrameView& frame, FrameFeatures& out) {
   const auto t0 = Clock::now();
   const int cams = rig_.size();
   for (int c = 0; c < cams; ++c) {
-    const bool given = c < frame.cameras && frame.present && frame.present[c] && frame.images && !frame.images[c].empty();
+    const bool given =
+        c < frame.cameras && frame.present && frame.present[c] && frame.images && !frame.images[c].empty();
     present_[c] = false;
     images_[c] = ImageView{};
     if (!given) continue;
@@ -43,7 +46,7 @@ void FrontEnd::compute(const RigFrameView& frame, FrameFeatures& out) {
   }
   out.t = frame.t;
   for (int c = 0; c < cams; ++c) out.present[c] = present_[c] ? 1 : 0;  // read by the matching tasks
-  matcher_.beginFrame(out, images_.data());  // the caller's images, alive for the call
+  matcher_.beginFrame(out, images_.data());                             // the caller's images, alive for the call
   matching_tasks_.setFrame(&out);
   workers_.extract(images_.data(), present_.get(), out.sets.data());  // an absent camera gets no keypoints
   const auto t1 = Clock::now();

@@ -31,8 +31,9 @@ void readCapacity(ConfigSection s, PipelineConfig& c) {
   s.read("max_landmarks", c.odometry.max_landmarks, 500, 2000000);
   s.finish();
   if (c.odometry.max_keyframes < c.odometry.window_keyframes + 2) {
-    s.fail("max_keyframes", "must exceed window_keyframes by at least 2 (got " + std::to_string(c.odometry.max_keyframes) +
-                                " and " + std::to_string(c.odometry.window_keyframes) + ")");
+    s.fail("max_keyframes", "must exceed window_keyframes by at least 2 (got " +
+                                std::to_string(c.odometry.max_keyframes) + " and " +
+                                std::to_string(c.odometry.window_keyframes) + ")");
   }
 }
 
@@ -125,7 +126,8 @@ PipelineConfig parsePipelineConfig(const YAML::Node& slam, const std::string& so
   c.odometry.new_points.min_depth = c.overlap.min_depth;
   c.multiview.triangulation.min_depth = c.overlap.min_depth;
   if (rig.size() < 1) throw InputError(source + ": the rig has no cameras");
-  if (rig.size() > 64) throw InputError(source + ": at most 64 cameras per rig (got " + std::to_string(rig.size()) + ")");
+  if (rig.size() > 64)
+    throw InputError(source + ": at most 64 cameras per rig (got " + std::to_string(rig.size()) + ")");
   return c;
 }
 

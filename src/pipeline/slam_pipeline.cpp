@@ -43,7 +43,8 @@ void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out
   if (handover_) {
     if (features_computed_ >= 2) {  // the first two frames keep the calibration
       const RigState& s = rig_after_[features_computed_ % 2];
-      for (int c = 0; c < rig_.size(); ++c) front_end_.setBodyFromCamera(c, s.reestimated(c) ? s.T_b_c(c) : rig_.T_b_c(c));
+      for (int c = 0; c < rig_.size(); ++c)
+        front_end_.setBodyFromCamera(c, s.reestimated(c) ? s.T_b_c(c) : rig_.T_b_c(c));
     }
     ++features_computed_;
   }

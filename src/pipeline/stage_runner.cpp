@@ -5,7 +5,8 @@
 namespace mcslam {
 
 StageSlots::StageSlots(FrameProcessor& processor)
-    : processor_(processor), staged_(processor.stageSlots() > 0),
+    : processor_(processor),
+      staged_(processor.stageSlots() > 0),
       poses_(static_cast<std::size_t>(std::max(processor.stageSlots(), 1))) {}
 
 void StageSlots::signal() {
@@ -29,8 +30,10 @@ int StageSlots::reserve() {
 }
 
 void StageSlots::prepare(int slot, const RigFrameView& frame) {
-  if (staged_) processor_.prepare(frame, slot);
-  else processor_.process(frame, poses_[static_cast<std::size_t>(slot)]);
+  if (staged_)
+    processor_.prepare(frame, slot);
+  else
+    processor_.process(frame, poses_[static_cast<std::size_t>(slot)]);
   prepared_.fetch_add(1, std::memory_order_release);
   signal();
 }
@@ -48,8 +51,10 @@ int StageSlots::next() {
 }
 
 void StageSlots::finish(int slot, PoseEstimate& out) {
-  if (staged_) processor_.finish(slot, out);
-  else out = poses_[static_cast<std::size_t>(slot)];
+  if (staged_)
+    processor_.finish(slot, out);
+  else
+    out = poses_[static_cast<std::size_t>(slot)];
   finished_.fetch_add(1, std::memory_order_release);
   signal();
 }

@@ -8,10 +8,10 @@
 namespace mcslam::sim {
 
 struct SpeedLimits {
-  double cruise = 1.0;        // m/s
-  double max_yaw_rate = 0.87; // rad/s
-  double lateral_accel = 0.9; // m/s^2
-  double accel = 0.5;         // m/s^2 (speeding up and slowing down)
+  double cruise = 1.0;         // m/s
+  double max_yaw_rate = 0.87;  // rad/s
+  double lateral_accel = 0.9;  // m/s^2
+  double accel = 0.5;          // m/s^2 (speeding up and slowing down)
 };
 
 class ArcTiming {

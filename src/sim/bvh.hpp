@@ -47,7 +47,8 @@ class Bvh {
     stack[top++] = 0;
     while (top > 0) {
       const BvhNode& n = nodes_[stack[--top]];
-      if (p[0] < n.lo[0] || p[1] < n.lo[1] || p[2] < n.lo[2] || p[0] > n.hi[0] || p[1] > n.hi[1] || p[2] > n.hi[2]) continue;
+      if (p[0] < n.lo[0] || p[1] < n.lo[1] || p[2] < n.lo[2] || p[0] > n.hi[0] || p[1] > n.hi[1] || p[2] > n.hi[2])
+        continue;
       if (n.count > 0) {
         for (int i = 0; i < n.count; ++i) visit(order_[n.first + i]);
       } else {
@@ -77,7 +78,7 @@ inline bool sphereMeetsCone(const float apex[3], const float axis[3], float cos_
   const float along = v0 * axis[0] + v1 * axis[1] + v2 * axis[2];
   // Angle of the centre from the axis must not exceed the cone angle plus the sphere's angular radius.
   const float sin_b = r / d, cos_b = std::sqrt(std::max(0.f, 1.f - sin_b * sin_b));
-  const float cos_sum = cos_a * cos_b - sin_a * sin_b;  // cos(a + b)
+  const float cos_sum = cos_a * cos_b - sin_a * sin_b;   // cos(a + b)
   if (sin_a * cos_b + cos_a * sin_b < 0.f) return true;  // a + b beyond pi
   return along >= d * cos_sum;
 }

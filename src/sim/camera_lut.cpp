@@ -179,7 +179,8 @@ void CameraLut::layout(int w, int h, int tile_size) {
 std::shared_ptr<const CameraLut> CameraLut::get(const CameraModel& m, int tile, WorkerPool& pool) {
   static std::mutex mutex;
   static std::map<Key, std::weak_ptr<const CameraLut>> cache;
-  const Key key{m.width(), m.height(), m.fx(), m.fy(), m.cx(), m.cy(), static_cast<int>(m.distortion()), m.coeffs(), tile};
+  const Key key{m.width(),  m.height(), m.fx(), m.fy(), m.cx(), m.cy(), static_cast<int>(m.distortion()),
+                m.coeffs(), tile};
   {
     std::lock_guard<std::mutex> lock(mutex);
     if (auto it = cache.find(key); it != cache.end()) {

@@ -16,8 +16,8 @@ namespace mcslam::sim {
 
 struct CameraLut {
   struct Tile {
-    float axis[3] = {0, 0, 1};  // camera frame
-    float cos_a = 1, sin_a = 0;   // half-angle of the cone holding every ray of the tile (with a pixel's margin)
+    float axis[3] = {0, 0, 1};   // camera frame
+    float cos_a = 1, sin_a = 0;  // half-angle of the cone holding every ray of the tile (with a pixel's margin)
     bool any_valid = false;
     // Four planes through the camera centre bounding the tile's rays more tightly than the cone: every ray b
     // of the tile has planes[i] . b >= 0. Not set (has_planes false) for tiles reaching 90 degrees off their axis.

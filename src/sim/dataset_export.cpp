@@ -76,9 +76,8 @@ ExportSummary exportDataset(Simulation& sim, const std::string& dir, const Expor
   out << "world: " << sim.world().name() << "\nseed: " << sim.world().seed() << "\ntrajectory: \""
       << sim.trajectory().description() << "\"\nrate_hz: " << sim.rate() << "\nframes: " << n << "\ncameras: [";
   for (std::size_t k = 0; k < cams.size(); ++k) out << (k ? ", " : "") << cams[k];
-  out << "]\npath_length_m: " << summary.path_length << "\nduration_s: " << summary.duration
-      << "\ndepth: " << (options.depth ? "camN/depth/<ns>.png, uint16 millimetres along the optical axis, 0 = none" : "none")
-      << "\n";
+  out << "]\npath_length_m: " << summary.path_length << "\nduration_s: " << summary.duration << "\ndepth: "
+      << (options.depth ? "camN/depth/<ns>.png, uint16 millimetres along the optical axis, 0 = none" : "none") << "\n";
   if (!out) throw InputError(info.string() + ": cannot write");
   return summary;
 }

@@ -11,7 +11,8 @@ namespace {
 class FileTrajectory : public SimTrajectory {
  public:
   explicit FileTrajectory(const std::string& path) : path_(path), poses_(readTumTrajectory(path)) {
-    if (poses_.size() < 2) throw InputError(path + ": a trajectory needs at least 2 poses, has " + std::to_string(poses_.size()));
+    if (poses_.size() < 2)
+      throw InputError(path + ": a trajectory needs at least 2 poses, has " + std::to_string(poses_.size()));
     for (std::size_t i = 1; i < poses_.size(); ++i) {
       if (poses_[i].t <= poses_[i - 1].t) {
         throw InputError(path + ": pose " + std::to_string(i + 1) + " is not later than the one before");
@@ -24,7 +25,8 @@ class FileTrajectory : public SimTrajectory {
 
   SE3 bodyPose(double t, const SE3&) const override {
     const Timestamp ts = poses_.front().t + fromSeconds(std::clamp(t, 0.0, duration()));
-    auto it = std::lower_bound(poses_.begin(), poses_.end(), ts, [](const StampedPose& p, Timestamp v) { return p.t < v; });
+    auto it =
+        std::lower_bound(poses_.begin(), poses_.end(), ts, [](const StampedPose& p, Timestamp v) { return p.t < v; });
     if (it == poses_.begin()) return poses_.front().T_w_b;
     if (it == poses_.end()) return poses_.back().T_w_b;
     const StampedPose& b = *it;

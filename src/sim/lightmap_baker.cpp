@@ -17,8 +17,8 @@ namespace {
 
 constexpr int kAmbientGrid = 4;  // 4 x 4 stratified, cosine-weighted directions
 constexpr int kAmbientSamples = kAmbientGrid * kAmbientGrid;
-constexpr int kLightSamples = 3;     // points on each light's disc, for soft shadows
-constexpr float kOffset = 0.002f;    // start rays this far off the surface
+constexpr int kLightSamples = 3;       // points on each light's disc, for soft shadows
+constexpr float kOffset = 0.002f;      // start rays this far off the surface
 constexpr float kIgnoreNear = 0.003f;  // occluders nearer than this (posters on walls) cast no shadow
 constexpr int kMaxCellsPerSide = 600;
 constexpr double kMaxCellsPerFace = 60000;  // large far-away faces get coarser cells
@@ -71,7 +71,8 @@ float irradiance(const WorldData& w, const Frame& f, uint64_t cell_seed) {
       const Vec3 target = L.position + r * (std::cos(a) * ax + std::sin(a) * ay);
       const Vec3 d = target - p;
       const double len = d.norm();
-      const float D[3] = {static_cast<float>(d.x() / len), static_cast<float>(d.y() / len), static_cast<float>(d.z() / len)};
+      const float D[3] = {static_cast<float>(d.x() / len), static_cast<float>(d.y() / len),
+                          static_cast<float>(d.z() / len)};
       if (!w.bvh.occluded(w.prims, f.p, D, kIgnoreNear, static_cast<float>(len) - 0.02f)) ++visible;
     }
     // Inverse square with a soft core so surfaces right next to a lamp do not blow up.
@@ -113,7 +114,8 @@ void smooth(float* v, int w, int h) {
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const float* r = v + static_cast<std::size_t>(y) * w;
-      tmp[static_cast<std::size_t>(y) * w + x] = 0.25f * r[std::max(0, x - 1)] + 0.5f * r[x] + 0.25f * r[std::min(w - 1, x + 1)];
+      tmp[static_cast<std::size_t>(y) * w + x] =
+          0.25f * r[std::max(0, x - 1)] + 0.5f * r[x] + 0.25f * r[std::min(w - 1, x + 1)];
     }
   }
   for (int y = 0; y < h; ++y) {

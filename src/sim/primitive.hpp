@@ -12,13 +12,13 @@ namespace mcslam::sim::detail {
 enum class PrimType : uint8_t { Box = 0, Cylinder = 1 };
 
 struct Prim {
-  float R[9];        // world -> local rotation, row-major (rows are the local axes in the world)
-  float c[3];        // centre in the world
-  float h[3];        // box: half extents; cylinder: radius, radius, half height
-  float radius;      // bounding sphere around c
-  uint32_t face0;    // first face record
+  float R[9];      // world -> local rotation, row-major (rows are the local axes in the world)
+  float c[3];      // centre in the world
+  float h[3];      // box: half extents; cylinder: radius, radius, half height
+  float radius;    // bounding sphere around c
+  uint32_t face0;  // first face record
   PrimType type;
-  bool aligned;      // R is the identity: rays need no rotation (walls, floors, most furniture)
+  bool aligned;  // R is the identity: rays need no rotation (walls, floors, most furniture)
 
   static Prim box(const SE3& T_w_o, const Vec3& half, uint32_t face0);
   static Prim cylinder(const SE3& T_w_o, double r, double half_height, uint32_t face0);
@@ -133,9 +133,18 @@ inline void faceUv(const Prim& p, int face, const float q[3], float& u, float& v
     const int k = face >> 1;
     const float s = (face & 1) ? 1.f : -1.f;
     switch (k) {
-      case 0: u = s * q[1] + p.h[1]; v = q[2] + p.h[2]; return;
-      case 1: u = -s * q[0] + p.h[0]; v = q[2] + p.h[2]; return;
-      default: u = s * q[0] + p.h[0]; v = q[1] + p.h[1]; return;
+      case 0:
+        u = s * q[1] + p.h[1];
+        v = q[2] + p.h[2];
+        return;
+      case 1:
+        u = -s * q[0] + p.h[0];
+        v = q[2] + p.h[2];
+        return;
+      default:
+        u = s * q[0] + p.h[0];
+        v = q[1] + p.h[1];
+        return;
     }
   }
   const float r = p.h[0];
@@ -172,9 +181,21 @@ inline void facePoint(const Prim& p, int face, float u, float v, float q[3]) {
     const int k = face >> 1;
     const float s = (face & 1) ? 1.f : -1.f;
     switch (k) {
-      case 0: q[0] = s * p.h[0]; q[1] = s * (u - p.h[1]); q[2] = v - p.h[2]; return;
-      case 1: q[1] = s * p.h[1]; q[0] = -s * (u - p.h[0]); q[2] = v - p.h[2]; return;
-      default: q[2] = s * p.h[2]; q[0] = s * (u - p.h[0]); q[1] = v - p.h[1]; return;
+      case 0:
+        q[0] = s * p.h[0];
+        q[1] = s * (u - p.h[1]);
+        q[2] = v - p.h[2];
+        return;
+      case 1:
+        q[1] = s * p.h[1];
+        q[0] = -s * (u - p.h[0]);
+        q[2] = v - p.h[2];
+        return;
+      default:
+        q[2] = s * p.h[2];
+        q[0] = s * (u - p.h[0]);
+        q[1] = v - p.h[1];
+        return;
     }
   }
   const float r = p.h[0];

@@ -23,15 +23,16 @@
 namespace mcslam::sim {
 
 struct Renderer::Impl {
-  Impl(const RenderOptions& o, const detail::WorldData& world) : pool(poolWorkers(o.threads)), sensor(o.sensor, o.seed), ctx(world) {}
+  Impl(const RenderOptions& o, const detail::WorldData& world)
+      : pool(poolWorkers(o.threads)), sensor(o.sensor, o.seed), ctx(world) {}
 
   WorkerPool pool;
   SensorModel sensor;
   FrameContext ctx;
   std::vector<std::shared_ptr<const CameraLut>> luts;
   const CameraLut* lut = nullptr;
-  std::vector<uint32_t> key;  // per pixel: surface hit by the centre ray
-  std::vector<float> t;       // and its distance
+  std::vector<uint32_t> key;    // per pixel: surface hit by the centre ray
+  std::vector<float> t;         // and its distance
   std::vector<float> radiance;  // sum over the sub-exposures of motion blur
   std::vector<std::vector<Candidate>> tile_cands;
   // Sub-pixel offsets of the anti-aliasing samples, padded to whole packets of four with copies of the last.
@@ -295,7 +296,8 @@ double Renderer::exposureGain(int cam, double time_s) const {
 }
 
 void Renderer::render(int cam, const SE3& T_w_b, double time_s, uint64_t frame_key, Image& image, DepthImage* depth) {
-  render(cam, [&T_w_b](double) { return T_w_b; }, time_s, frame_key, image, depth);
+  render(
+      cam, [&T_w_b](double) { return T_w_b; }, time_s, frame_key, image, depth);
 }
 
 void Renderer::render(int cam, const std::function<SE3(double)>& T_w_b_at, double time_s, uint64_t frame_key,

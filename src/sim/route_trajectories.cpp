@@ -45,8 +45,7 @@ class LoopWobble {
 
 class GroundTrajectory : public PlatformTrajectory {
  public:
-  GroundTrajectory(const World& world, uint64_t seed, const GroundOptions& o)
-      : curve_(world.route()), options_(o) {
+  GroundTrajectory(const World& world, uint64_t seed, const GroundOptions& o) : curve_(world.route()), options_(o) {
     checkRouteClearance(world, curve_, world.route().clearance);
     SpeedLimits lim;
     lim.cruise = o.cruise_speed;

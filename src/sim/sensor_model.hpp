@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "hash.hpp"
-#include "simd4.hpp"
 #include "mcslam/sim/renderer.hpp"
+#include "simd4.hpp"
 
 namespace mcslam::sim {
 
@@ -37,10 +37,9 @@ class SensorModel {
   template <class F>
   F vignette(F bz) const {
     const float s = options_.vignetting ? strength_ : 0.f;  // 0: gain 1 everywhere
-    const F g = 1.f - s * vmin(1.f - bz * bz, 1.f);          // 1 - s sin^2 of the angle off the axis (beyond 90 deg too)
+    const F g = 1.f - s * vmin(1.f - bz * bz, 1.f);         // 1 - s sin^2 of the angle off the axis (beyond 90 deg too)
     return bz < 0.f ? vmax(g - s * 0.5f * (-bz), 0.3f) : vmax(g, 0.3f);
   }
-
 
  private:
   static constexpr uint32_t kGaussBits = 12;

@@ -65,7 +65,8 @@ Trajectory Simulation::groundTruth() const {
 void Simulation::render(int frame, int cam, Image& image, DepthImage* depth) {
   const double t = frameTime(frame);
   if (renderer_->options().sensor.motion_blur_s > 0) {
-    renderer_->render(cam, [this](double tt) { return bodyPoseAt(tt); }, t, static_cast<uint64_t>(frame), image, depth);
+    renderer_->render(
+        cam, [this](double tt) { return bodyPoseAt(tt); }, t, static_cast<uint64_t>(frame), image, depth);
   } else {
     renderer_->render(cam, bodyPoseAt(t), t, static_cast<uint64_t>(frame), image, depth);
   }

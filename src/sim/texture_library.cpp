@@ -8,10 +8,10 @@
 
 #include "hash.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/core/worker_pool.hpp"
 #include "mcslam/dataset/image_file.hpp"
 #include "texture_kinds.hpp"
 #include "texture_paint.hpp"
-#include "mcslam/core/worker_pool.hpp"
 
 namespace mcslam::sim {
 
@@ -23,7 +23,8 @@ constexpr int kPhotoSize = 512;  // each photo becomes kPhotoSize^2, mirrored to
 
 bool isImageFile(const fs::path& p) {
   std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
 }
 
@@ -34,7 +35,8 @@ MipTexture photoTexture(const std::string& path) {
   const int side = std::min(grey.cols, grey.rows);  // centre square crop
   cv::Mat square = grey(cv::Rect((grey.cols - side) / 2, (grey.rows - side) / 2, side, side));
   cv::Mat small;
-  cv::resize(square, small, cv::Size(kPhotoSize, kPhotoSize), 0, 0, side > kPhotoSize ? cv::INTER_AREA : cv::INTER_CUBIC);
+  cv::resize(square, small, cv::Size(kPhotoSize, kPhotoSize), 0, 0,
+             side > kPhotoSize ? cv::INTER_AREA : cv::INTER_CUBIC);
   cv::Mat right, top, full;
   cv::flip(small, right, 1);
   cv::hconcat(small, right, top);

@@ -102,8 +102,7 @@ void blendShapeWrapped(cv::Mat& img, cv::Rect bounds, float value, float opacity
       const cv::Rect shifted = bounds + cv::Point(dx * img.cols, dy * img.rows);
       if ((shifted & cv::Rect(0, 0, img.cols, img.rows)).empty()) continue;
       const cv::Point shift(dx * img.cols, dy * img.rows);
-      blendShape(img, shifted, value, opacity,
-                 [&](cv::Mat& mask, cv::Point offset) { draw(mask, offset - shift); });
+      blendShape(img, shifted, value, opacity, [&](cv::Mat& mask, cv::Point offset) { draw(mask, offset - shift); });
     }
   }
 }
@@ -133,32 +132,42 @@ void fillRect(cv::Mat& img, cv::Rect r, float value, float opacity) {
 
 void fillCircle(cv::Mat& img, cv::Point2f c, float radius, float value, float opacity, bool wrap) {
   const int pad = 2;
-  const cv::Rect bounds(static_cast<int>(std::floor(c.x - radius)) - pad, static_cast<int>(std::floor(c.y - radius)) - pad,
-                        static_cast<int>(2 * radius) + 2 * pad + 2, static_cast<int>(2 * radius) + 2 * pad + 2);
+  const cv::Rect bounds(static_cast<int>(std::floor(c.x - radius)) - pad,
+                        static_cast<int>(std::floor(c.y - radius)) - pad, static_cast<int>(2 * radius) + 2 * pad + 2,
+                        static_cast<int>(2 * radius) + 2 * pad + 2);
   const DrawFn draw = [&](cv::Mat& mask, cv::Point o) {
     // Sub-pixel centre and radius through OpenCV's fixed-point shift.
     constexpr int kShift = 4;
-    const cv::Point cc(static_cast<int>(std::lround((c.x - o.x) * 16)), static_cast<int>(std::lround((c.y - o.y) * 16)));
+    const cv::Point cc(static_cast<int>(std::lround((c.x - o.x) * 16)),
+                       static_cast<int>(std::lround((c.y - o.y) * 16)));
     cv::circle(mask, cc, std::max(1, static_cast<int>(std::lround(radius * 16))), cv::Scalar(255), cv::FILLED,
                cv::LINE_AA, kShift);
   };
-  if (wrap) blendShapeWrapped(img, bounds, value, opacity, draw);
-  else blendShape(img, bounds, value, opacity, draw);
+  if (wrap)
+    blendShapeWrapped(img, bounds, value, opacity, draw);
+  else
+    blendShape(img, bounds, value, opacity, draw);
 }
 
 void drawLine(cv::Mat& img, cv::Point2f a, cv::Point2f b, float thickness, float value, float opacity, bool wrap) {
   const int pad = static_cast<int>(thickness) + 3;
-  const int x0 = static_cast<int>(std::floor(std::min(a.x, b.x))) - pad, y0 = static_cast<int>(std::floor(std::min(a.y, b.y))) - pad;
-  const int x1 = static_cast<int>(std::ceil(std::max(a.x, b.x))) + pad, y1 = static_cast<int>(std::ceil(std::max(a.y, b.y))) + pad;
+  const int x0 = static_cast<int>(std::floor(std::min(a.x, b.x))) - pad,
+            y0 = static_cast<int>(std::floor(std::min(a.y, b.y))) - pad;
+  const int x1 = static_cast<int>(std::ceil(std::max(a.x, b.x))) + pad,
+            y1 = static_cast<int>(std::ceil(std::max(a.y, b.y))) + pad;
   const cv::Rect bounds(x0, y0, x1 - x0, y1 - y0);
   const DrawFn draw = [&](cv::Mat& mask, cv::Point o) {
     constexpr int kShift = 4;
-    const cv::Point pa(static_cast<int>(std::lround((a.x - o.x) * 16)), static_cast<int>(std::lround((a.y - o.y) * 16)));
-    const cv::Point pb(static_cast<int>(std::lround((b.x - o.x) * 16)), static_cast<int>(std::lround((b.y - o.y) * 16)));
+    const cv::Point pa(static_cast<int>(std::lround((a.x - o.x) * 16)),
+                       static_cast<int>(std::lround((a.y - o.y) * 16)));
+    const cv::Point pb(static_cast<int>(std::lround((b.x - o.x) * 16)),
+                       static_cast<int>(std::lround((b.y - o.y) * 16)));
     cv::line(mask, pa, pb, cv::Scalar(255), std::max(1, static_cast<int>(std::lround(thickness))), cv::LINE_AA, kShift);
   };
-  if (wrap) blendShapeWrapped(img, bounds, value, opacity, draw);
-  else blendShape(img, bounds, value, opacity, draw);
+  if (wrap)
+    blendShapeWrapped(img, bounds, value, opacity, draw);
+  else
+    blendShape(img, bounds, value, opacity, draw);
 }
 
 int drawText(cv::Mat& img, const std::string& text, cv::Point origin, int font, double scale, int thickness,
@@ -218,7 +227,7 @@ std::string randomHeading(Rng& rng) {
 
 int randomFont(Rng& rng) {
   static const int kFonts[] = {cv::FONT_HERSHEY_SIMPLEX, cv::FONT_HERSHEY_DUPLEX, cv::FONT_HERSHEY_COMPLEX,
-                               cv::FONT_HERSHEY_TRIPLEX, cv::FONT_HERSHEY_PLAIN, cv::FONT_HERSHEY_COMPLEX_SMALL};
+                               cv::FONT_HERSHEY_TRIPLEX, cv::FONT_HERSHEY_PLAIN,  cv::FONT_HERSHEY_COMPLEX_SMALL};
   return kFonts[rng.integer(0, 5)];
 }
 

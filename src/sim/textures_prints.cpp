@@ -43,8 +43,7 @@ void picture(cv::Mat& img, Rng& rng, cv::Rect r, uint64_t seed) {
     const float base = static_cast<float>(rng.uniform(0.45, 0.75));
     std::vector<cv::Point> poly{{r.x, r.y + r.height}};
     for (int i = 0; i <= 12; ++i) {
-      poly.emplace_back(r.x + r.width * i / 12,
-                        r.y + static_cast<int>(r.height * (base + rng.uniform(-0.15, 0.1))));
+      poly.emplace_back(r.x + r.width * i / 12, r.y + static_cast<int>(r.height * (base + rng.uniform(-0.15, 0.1))));
     }
     poly.emplace_back(r.x + r.width, r.y + r.height);
     const float v = static_cast<float>(rng.uniform(0.05, 0.35));
@@ -89,13 +88,15 @@ PaintedTexture paintPoster(uint64_t seed) {
   double scale = 3.0;
   int baseline = 0;
   while (scale > 0.6 && cv::getTextSize(title, font, scale, 3, &baseline).width > W - 2 * margin) scale *= 0.85;
-  drawText(img, title, {margin, margin + static_cast<int>(30 * scale)}, font, scale, std::max(1, static_cast<int>(scale * 1.5)), ink);
+  drawText(img, title, {margin, margin + static_cast<int>(30 * scale)}, font, scale,
+           std::max(1, static_cast<int>(scale * 1.5)), ink);
   const int top = margin + static_cast<int>(40 * scale) + 10;
   // A picture and text, in one of a few layouts.
   const int layout = rng.integer(0, 2);
   if (layout == 0) {
     picture(img, rng, cv::Rect(margin, top, W - 2 * margin, (H - top) / 2), seed);
-    textBlock(img, rng, cv::Rect(margin, top + (H - top) / 2 + 10, W - 2 * margin, (H - top) / 2 - margin - 10), ink, 1.0);
+    textBlock(img, rng, cv::Rect(margin, top + (H - top) / 2 + 10, W - 2 * margin, (H - top) / 2 - margin - 10), ink,
+              1.0);
   } else if (layout == 1) {
     picture(img, rng, cv::Rect(margin, top, (W - 2 * margin) / 2 - 8, H - top - margin), seed);
     textBlock(img, rng, cv::Rect(W / 2 + 8, top, W / 2 - margin - 8, H - top - margin), ink, 0.9);
@@ -127,8 +128,10 @@ PaintedTexture paintNoticeBoard(uint64_t seed) {
     const float ink = static_cast<float>(rng.uniform(0.0, 0.2));
     drawText(img, randomHeading(rng), {x + 8, y + 28}, cv::FONT_HERSHEY_DUPLEX, 0.7, 2, ink);
     if (rng.chance(0.4)) picture(img, rng, cv::Rect(x + 8, y + 38, w - 16, h / 3), hashOf(seed, i));
-    textBlock(img, rng, cv::Rect(x + 8, y + (h > 200 ? h / 3 + 44 : 40), w - 16, h - (h > 200 ? h / 3 + 52 : 48)), ink, 0.6);
-    fillCircle(img, {static_cast<float>(x + w / 2), static_cast<float>(y + 8)}, 5.f, static_cast<float>(rng.uniform(0.05, 0.8)));
+    textBlock(img, rng, cv::Rect(x + 8, y + (h > 200 ? h / 3 + 44 : 40), w - 16, h - (h > 200 ? h / 3 + 52 : 48)), ink,
+              0.6);
+    fillCircle(img, {static_cast<float>(x + w / 2), static_cast<float>(y + 8)}, 5.f,
+               static_cast<float>(rng.uniform(0.05, 0.8)));
   }
   bevel(img, cv::Rect(0, 0, W, H), 14, 0.85f, 0.55f);
   return {img, false};
@@ -143,7 +146,8 @@ PaintedTexture paintWhiteboard(uint64_t seed) {
     const float ink = static_cast<float>(rng.uniform(0.05, 0.4));
     const int x = rng.integer(40, W - 300), y = rng.integer(60, H - 60);
     if (rng.chance(0.5)) {
-      drawText(img, randomWords(rng, rng.integer(1, 4)), {x, y}, cv::FONT_HERSHEY_SCRIPT_SIMPLEX, rng.uniform(0.8, 1.5), 2, ink);
+      drawText(img, randomWords(rng, rng.integer(1, 4)), {x, y}, cv::FONT_HERSHEY_SCRIPT_SIMPLEX, rng.uniform(0.8, 1.5),
+               2, ink);
     } else if (rng.chance(0.5)) {
       const int w = rng.integer(60, 200), h = rng.integer(40, 120);
       drawLine(img, cv::Point2f(x, y), cv::Point2f(x + w, y), 3, ink);
@@ -156,7 +160,8 @@ PaintedTexture paintWhiteboard(uint64_t seed) {
       drawLine(img, cv::Point2f(x, y), cv::Point2f(x + 220, y), 3, ink);
       cv::Point2f prev(x, y - 10);
       for (int k = 1; k <= 20; ++k) {
-        const cv::Point2f p(x + k * 11.f, y - 10 - 110.f * static_cast<float>(std::pow(k / 20.0, rng.uniform(0.5, 2.5))));
+        const cv::Point2f p(x + k * 11.f,
+                            y - 10 - 110.f * static_cast<float>(std::pow(k / 20.0, rng.uniform(0.5, 2.5))));
         drawLine(img, prev, p, 3, ink);
         prev = p;
       }
@@ -192,8 +197,9 @@ PaintedTexture paintBooks(uint64_t seed) {
         fillRect(img, cv::Rect(x, floor_y - h + h / 8, w, 4), ink, 0.8f);
         fillRect(img, cv::Rect(x, floor_y - h / 6, w, 4), ink, 0.8f);
       }
-      if (w >= 16) drawVerticalText(img, randomWords(rng, 2), cv::Rect(x + 2, floor_y - h + h / 5, w - 4, h * 3 / 5),
-                                    cv::FONT_HERSHEY_PLAIN, 0.9, 1, ink);
+      if (w >= 16)
+        drawVerticalText(img, randomWords(rng, 2), cv::Rect(x + 2, floor_y - h + h / 5, w - 4, h * 3 / 5),
+                         cv::FONT_HERSHEY_PLAIN, 0.9, 1, ink);
       fillRect(img, cv::Rect(x + w - 1, floor_y - h, 1, h), 0.05f, 0.6f);  // gap shadow
       x += w + (rng.chance(0.2) ? 2 : 0);
     }
@@ -277,7 +283,8 @@ PaintedTexture paintFacade(uint64_t seed) {
   cv::Mat img;
   cv::repeat(wall, 4, 4, img);
   img = img * rng.uniform(0.85, 1.25);
-  const int win_w = static_cast<int>(bw * rng.uniform(0.45, 0.7)), win_h = static_cast<int>(sh * rng.uniform(0.45, 0.65));
+  const int win_w = static_cast<int>(bw * rng.uniform(0.45, 0.7)),
+            win_h = static_cast<int>(sh * rng.uniform(0.45, 0.65));
   for (int s = 0; s < storeys; ++s) {
     fillRect(img, cv::Rect(0, s * sh, W, 8), 0.75f, 0.7f);  // floor slab band
     for (int b = 0; b < bays; ++b) {
@@ -287,7 +294,8 @@ PaintedTexture paintFacade(uint64_t seed) {
       addFbm(glass, hashOf(seed, s, b), win_w / 2.0, 4, 0.06f, 0.8);  // reflections
       const int kind = rng.integer(0, 3);
       if (kind == 0) {  // blinds
-        for (int y = win.y; y < win.y + win.height; y += 6) fillRect(img, cv::Rect(win.x, y, win.width, 3), 0.75f, 0.8f);
+        for (int y = win.y; y < win.y + win.height; y += 6)
+          fillRect(img, cv::Rect(win.x, y, win.width, 3), 0.75f, 0.8f);
       } else if (kind == 1) {  // curtains
         fillRect(img, cv::Rect(win.x, win.y, win.width / 4, win.height), 0.6f, 0.9f);
         fillRect(img, cv::Rect(win.x + win.width * 3 / 4, win.y, win.width / 4, win.height), 0.6f, 0.9f);
@@ -316,7 +324,8 @@ PaintedTexture paintPerson(uint64_t seed) {
   fillRect(img, cv::Rect(0, 0, W, head / 3), static_cast<float>(rng.uniform(0.03, 0.5)));  // hair
   fillRect(img, cv::Rect(0, head, W, waist - head), shirt);
   if (rng.chance(0.4)) {
-    for (int y = head; y < waist; y += 24) fillRect(img, cv::Rect(0, y, W, 10), shirt > 0.5f ? shirt - 0.3f : shirt + 0.3f);
+    for (int y = head; y < waist; y += 24)
+      fillRect(img, cv::Rect(0, y, W, 10), shirt > 0.5f ? shirt - 0.3f : shirt + 0.3f);
   }
   fillRect(img, cv::Rect(0, head, W / 6, waist - head + 40), shirt * 0.8f);  // arms at the sides
   fillRect(img, cv::Rect(W - W / 6, head, W / 6, waist - head + 40), shirt * 0.8f);

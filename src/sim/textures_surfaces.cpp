@@ -40,7 +40,8 @@ void crack(cv::Mat& img, Rng& rng, float value, float opacity, int steps, float 
   double heading = rng.uniform(0, 2 * M_PI);
   for (int i = 0; i < steps; ++i) {
     heading += rng.normal() * 0.35;
-    const cv::Point2f q = p + cv::Point2f(static_cast<float>(std::cos(heading) * step), static_cast<float>(std::sin(heading) * step));
+    const cv::Point2f q =
+        p + cv::Point2f(static_cast<float>(std::cos(heading) * step), static_cast<float>(std::sin(heading) * step));
     drawLine(img, p, q, thickness, value, opacity, true);
     p = q;
   }
@@ -51,9 +52,9 @@ void crack(cv::Mat& img, Rng& rng, float value, float opacity, int steps, float 
 PaintedTexture paintPlaster(uint64_t seed) {
   Rng rng(seed);
   cv::Mat img = canvas(512, 512, static_cast<float>(rng.uniform(0.70, 0.86)));
-  addFbm(img, hashOf(seed, 1), 256, 32, 0.004f, 0.7);          // trowel and paint unevenness, faint
-  addFbm(img, hashOf(seed, 2), 16, 1, 0.010f, 0.3);            // fine grain, only seen close up
-  addFbm(img, hashOf(seed, 3), 512, 32, 0.004f, 0.5, 8.0);     // roller streaks
+  addFbm(img, hashOf(seed, 1), 256, 32, 0.004f, 0.7);       // trowel and paint unevenness, faint
+  addFbm(img, hashOf(seed, 2), 16, 1, 0.010f, 0.3);         // fine grain, only seen close up
+  addFbm(img, hashOf(seed, 3), 512, 32, 0.004f, 0.5, 8.0);  // roller streaks
   return {img, true};
 }
 
@@ -62,8 +63,8 @@ PaintedTexture paintConcrete(uint64_t seed) {
   cv::Mat img = canvas(1024, 1024, static_cast<float>(rng.uniform(0.52, 0.66)));
   addFbm(img, hashOf(seed, 1), 512, 2, 0.10f, 1.0);
   blotches(img, hashOf(seed, 2), 0.10f, 512);
-  speckle(img, rng, 2500, 0.6f, 2.2f, 0.15f, 0.35f);   // pores
-  speckle(img, rng, 600, 0.6f, 1.5f, 0.75f, 0.85f);    // light grit
+  speckle(img, rng, 2500, 0.6f, 2.2f, 0.15f, 0.35f);  // pores
+  speckle(img, rng, 600, 0.6f, 1.5f, 0.75f, 0.85f);   // light grit
   // Formwork panel seams and tie holes, period 512 texels.
   const float seam = static_cast<float>(rng.uniform(0.30, 0.42));
   for (int k = 0; k < 2; ++k) {
@@ -71,7 +72,8 @@ PaintedTexture paintConcrete(uint64_t seed) {
     drawLine(img, {x, 0}, {x, 1024}, 2.f, seam, 0.6f, true);
     drawLine(img, {0, x + 100}, {1024, x + 100}, 2.f, seam, 0.6f, true);
     for (int j = 0; j < 2; ++j) {
-      for (int i = 0; i < 2; ++i) fillCircle(img, {x + 128.f + 256.f * i, x + 228.f + 256.f * j}, 7.f, 0.22f, 0.9f, true);
+      for (int i = 0; i < 2; ++i)
+        fillCircle(img, {x + 128.f + 256.f * i, x + 228.f + 256.f * j}, 7.f, 0.22f, 0.9f, true);
     }
   }
   for (int i = 0; i < 3; ++i) crack(img, rng, 0.3f, 0.5f, 40, 6.f, 1.f);
@@ -227,7 +229,8 @@ PaintedTexture paintMetal(uint64_t seed) {
   addFbm(img, hashOf(seed, 2), 256, 32, 0.04f, 0.5);
   for (int i = 0; i < 25; ++i) {
     const cv::Point2f a(static_cast<float>(rng.uniform(0, W)), static_cast<float>(rng.uniform(0, W)));
-    const cv::Point2f b = a + cv::Point2f(static_cast<float>(rng.uniform(-60, 60)), static_cast<float>(rng.uniform(-15, 15)));
+    const cv::Point2f b =
+        a + cv::Point2f(static_cast<float>(rng.uniform(-60, 60)), static_cast<float>(rng.uniform(-15, 15)));
     drawLine(img, a, b, 1.f, static_cast<float>(rng.uniform(0.3, 0.9)), 0.5f, true);
   }
   return {img, true};
@@ -281,7 +284,8 @@ PaintedTexture paintGrass(uint64_t seed) {
     const cv::Point2f a(static_cast<float>(rng.uniform(0, W)), static_cast<float>(rng.uniform(0, W)));
     const double ang = rng.uniform(-0.5, 0.5) - M_PI / 2;
     const double len = rng.uniform(4, 14);
-    const cv::Point2f b = a + cv::Point2f(static_cast<float>(std::cos(ang) * len), static_cast<float>(std::sin(ang) * len));
+    const cv::Point2f b =
+        a + cv::Point2f(static_cast<float>(std::cos(ang) * len), static_cast<float>(std::sin(ang) * len));
     drawLine(img, a, b, 1.f, static_cast<float>(rng.uniform(0.1, 0.6)), 0.7f, true);
   }
   return {img, true};
@@ -310,8 +314,8 @@ PaintedTexture paintBark(uint64_t seed) {
   for (int i = 0; i < 30; ++i) {
     const float x = static_cast<float>(rng.uniform(0, W));
     const float y = static_cast<float>(rng.uniform(0, W));
-    drawLine(img, {x, y}, {x + static_cast<float>(rng.uniform(-6, 6)), y + static_cast<float>(rng.uniform(40, 140))}, 2.f,
-             0.08f, 0.8f, true);
+    drawLine(img, {x, y}, {x + static_cast<float>(rng.uniform(-6, 6)), y + static_cast<float>(rng.uniform(40, 140))},
+             2.f, 0.08f, 0.8f, true);
   }
   return {img, true};
 }

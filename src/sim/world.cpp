@@ -10,10 +10,10 @@ using detail::Prim;
 using detail::WorldData;
 
 const char* textureKindName(TextureKind kind) {
-  static const char* kNames[] = {"plaster", "concrete", "brick",  "wood-planks", "wood-panel", "tiles",    "linoleum",
-                                 "carpet",  "fabric",   "metal",  "ceiling",     "poster",     "notice",   "whiteboard",
-                                 "books",   "door",     "cabinet", "facade",     "paving",     "grass",    "foliage",
-                                 "bark",    "asphalt",  "person", "radiator"};
+  static const char* kNames[] = {"plaster", "concrete", "brick",   "wood-planks", "wood-panel", "tiles",  "linoleum",
+                                 "carpet",  "fabric",   "metal",   "ceiling",     "poster",     "notice", "whiteboard",
+                                 "books",   "door",     "cabinet", "facade",      "paving",     "grass",  "foliage",
+                                 "bark",    "asphalt",  "person",  "radiator"};
   const int i = static_cast<int>(kind);
   return i >= 0 && i < static_cast<int>(TextureKind::Count) ? kNames[i] : "?";
 }
@@ -103,7 +103,8 @@ SE3 WorldData::walkerPose(int i, double t) const {
   const Vec2 p = w.a + s * ab;
   // Turn round smoothly near each end (phi around 0/2 and 1).
   auto ramp = [](double x) { return x <= 0 ? 0.0 : (x >= 1 ? 1.0 : x * x * (3 - 2 * x)); };
-  const double turn = ramp((phi - 0.92) / 0.16) + ramp((phi - 1.92) / 0.16) + (phi < 0.08 ? ramp((phi + 0.08) / 0.16) - 1 : 0);
+  const double turn =
+      ramp((phi - 0.92) / 0.16) + ramp((phi - 1.92) / 0.16) + (phi < 0.08 ? ramp((phi + 0.08) / 0.16) - 1 : 0);
   const double yaw = std::atan2(ab.y(), ab.x()) + M_PI * turn;
   // Slight bob while walking.
   const double bob = 0.02 * std::abs(std::sin(M_PI * s * len / 0.7));
@@ -118,8 +119,10 @@ float WorldData::unlitIrradiance(const Vec3& n) const {
   // Ambient from above is brighter than from below; sun or ceiling lights add a directional part.
   const double up = 0.5 * (1.0 + n.z());
   double e = ambient_open * (0.6 + 0.6 * up);
-  if (sun_irradiance > 0) e += sun_irradiance * std::max(0.0, n.dot(sun_direction)) * 0.8;
-  else if (!lights.empty()) e += lights.front().intensity * 0.08 * (0.5 + 0.5 * up);
+  if (sun_irradiance > 0)
+    e += sun_irradiance * std::max(0.0, n.dot(sun_direction)) * 0.8;
+  else if (!lights.empty())
+    e += lights.front().intensity * 0.08 * (0.5 + 0.5 * up);
   return static_cast<float>(e);
 }
 

@@ -5,8 +5,8 @@
 #include "hash.hpp"
 #include "lightmap_baker.hpp"
 #include "mcslam/core/error.hpp"
-#include "texture_library.hpp"
 #include "sim_pool.hpp"
+#include "texture_library.hpp"
 #include "world_data.hpp"
 
 namespace mcslam::sim {
@@ -63,7 +63,8 @@ void precomputeBoxFaces(WorldData& d) {
     }
   }
   for (std::size_t w = 0; w < d.walkers.size(); ++w) {
-    const float h[3] = {static_cast<float>(d.walkers[w].half_extents.x()), static_cast<float>(d.walkers[w].half_extents.y()),
+    const float h[3] = {static_cast<float>(d.walkers[w].half_extents.x()),
+                        static_cast<float>(d.walkers[w].half_extents.y()),
                         static_cast<float>(d.walkers[w].half_extents.z())};
     for (int f = 0; f < 6; ++f) precomputeBoxFace(d.faces[d.walker_face0[w] + f], f, h, nullptr);
   }
@@ -185,7 +186,7 @@ namespace {
 
 // Which object owns each face (fitted textures are unique per object), and the face's index within it.
 struct FaceOwners {
-  std::vector<int> owner;          // prim index, -1 for a walker's face
+  std::vector<int> owner;  // prim index, -1 for a walker's face
   std::vector<int> face_in_owner;
 };
 

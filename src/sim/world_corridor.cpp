@@ -28,10 +28,14 @@ bool inBare(double x0, double x1) {
 void furnishHall(WorldBuilder& b, Room& hall, Rng& rng, const layout::KeepOut& keep) {
   layout::fillWallSlots(hall, rng, keep, 1.6, 0.6, 1.2, 0.8, [&](const Vec2& c, double yaw) {
     const int kind = rng.integer(0, 3);
-    if (kind == 0) kit::addSofa(b, rng, c, yaw, 1.6);
-    else if (kind == 1) kit::addCabinet(b, rng, c, yaw, 1.2, 0.6, 1.8);  // vending machine / locker
-    else if (kind == 2) kit::addPlant(b, rng, c, rng.uniform(1.2, 1.9));
-    else kit::addBookshelf(b, rng, c, yaw, 1.2, 1.9);
+    if (kind == 0)
+      kit::addSofa(b, rng, c, yaw, 1.6);
+    else if (kind == 1)
+      kit::addCabinet(b, rng, c, yaw, 1.2, 0.6, 1.8);  // vending machine / locker
+    else if (kind == 2)
+      kit::addPlant(b, rng, c, rng.uniform(1.2, 1.9));
+    else
+      kit::addBookshelf(b, rng, c, yaw, 1.2, 1.9);
   });
   layout::decorateWalls(b, hall, rng, 3);
 }
@@ -43,8 +47,9 @@ std::shared_ptr<const World> buildCorridorWorld(const WorldOptions& options) {
   Rng rng(hashOf(options.seed, 0xc044));
 
   RouteSpec route;
-  route.corners = {Vec2(-4.0, -2.0), Vec2(-0.8, -0.4), Vec2(kLength + 0.8, -0.4), Vec2(kLength + 4.0, -2.0),
-                   Vec2(kLength + 4.0, 2.0), Vec2(kLength + 0.8, 0.4), Vec2(-0.8, 0.4), Vec2(-4.0, 2.0)};
+  route.corners = {Vec2(-4.0, -2.0),          Vec2(-0.8, -0.4),         Vec2(kLength + 0.8, -0.4),
+                   Vec2(kLength + 4.0, -2.0), Vec2(kLength + 4.0, 2.0), Vec2(kLength + 0.8, 0.4),
+                   Vec2(-0.8, 0.4),           Vec2(-4.0, 2.0)};
   route.radii = {1.0, 2.0, 2.0, 1.0, 1.0, 2.0, 2.0, 1.0};
   route.stops = {3};
   route.clearance = 0.45;
@@ -67,7 +72,8 @@ std::shared_ptr<const World> buildCorridorWorld(const WorldOptions& options) {
   kit::Wall north{Vec2(kLength, kHalfWidth), Vec2(0, kHalfWidth), kHeight, 0.15};
   kit::addWall(b, south, wall_paint, Material::unseen());
   kit::addWall(b, north, wall_paint, Material::unseen());
-  kit::addFloor(b, Vec2(0, -kHalfWidth), Vec2(kLength, kHalfWidth), Material::texture(TextureKind::Linoleum, 1.0, 0.002));
+  kit::addFloor(b, Vec2(0, -kHalfWidth), Vec2(kLength, kHalfWidth),
+                Material::texture(TextureKind::Linoleum, 1.0, 0.002));
   kit::addCeiling(b, Vec2(0, -kHalfWidth), Vec2(kLength, kHalfWidth), kHeight, ceiling);
   for (double x = 1.5; x < kLength; x += 3.0) kit::addCeilingLight(b, Vec2(x, 0.0), kHeight, 4.5);
   // Decorations outside the bare stretches; skirting everywhere.
@@ -77,10 +83,14 @@ std::shared_ptr<const World> buildCorridorWorld(const WorldOptions& options) {
       const double x = w == &south ? s : kLength - s;
       if (inBare(x - 1.0, x + 1.0)) continue;
       const int kind = rng.integer(0, 4);
-      if (kind <= 1) kit::addDoor(b, *w, true, s, 0.9);
-      else if (kind == 2) kit::addPoster(b, *w, true, s, 1.5, 0.6, 0.85);
-      else if (kind == 3) kit::addNoticeBoard(b, *w, true, s, 1.45, 1.3, 0.8);
-      else kit::addRadiator(b, *w, true, s, 1.0);
+      if (kind <= 1)
+        kit::addDoor(b, *w, true, s, 0.9);
+      else if (kind == 2)
+        kit::addPoster(b, *w, true, s, 1.5, 0.6, 0.85);
+      else if (kind == 3)
+        kit::addNoticeBoard(b, *w, true, s, 1.45, 1.3, 0.8);
+      else
+        kit::addRadiator(b, *w, true, s, 1.0);
     }
   }
 

@@ -19,10 +19,12 @@ void addTree(WorldBuilder& b, Rng& rng, const Vec2& c) {
   // The crown: a few overlapping drums of leaves, for a lumpy outline.
   const Material leaves = Material::texture(TextureKind::Foliage, rng.uniform(0.8, 1.2), 0.004);
   for (int k = 0; k < 4; ++k) {
-    const double r = crown_r * (k == 0 ? 1.0 : rng.uniform(0.5, 0.8)), h = crown_h * (k == 0 ? 0.7 : rng.uniform(0.4, 0.6));
+    const double r = crown_r * (k == 0 ? 1.0 : rng.uniform(0.5, 0.8)),
+                 h = crown_h * (k == 0 ? 0.7 : rng.uniform(0.4, 0.6));
     const Vec2 off = k == 0 ? Vec2(0, 0) : Vec2(Vec2(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5)) * crown_r);
     const double z = trunk_h + (k == 0 ? 0.45 * crown_h : rng.uniform(0.3, 0.8) * crown_h);
-    b.addCylinder(SE3(yawMatrix(rng.uniform(0, 6.28)), Vec3(c.x() + off.x(), c.y() + off.y(), z)), r, 0.5 * h, leaves, leaves);
+    b.addCylinder(SE3(yawMatrix(rng.uniform(0, 6.28)), Vec3(c.x() + off.x(), c.y() + off.y(), z)), r, 0.5 * h, leaves,
+                  leaves);
   }
 }
 
@@ -79,8 +81,8 @@ void addBuildings(WorldBuilder& b, Rng& rng) {
     Vec3 lo, hi;
   };
   const Building buildings[] = {
-      {Vec3(-40, 18, 0), Vec3(18, 30, 11.0)},   {Vec3(-40, -32, 0), Vec3(30, -20, 9.5)},
-      {Vec3(26, -20, 0), Vec3(38, 12, 13.0)},   {Vec3(-40, -20, 0), Vec3(-27, 18, 10.0)},
+      {Vec3(-40, 18, 0), Vec3(18, 30, 11.0)}, {Vec3(-40, -32, 0), Vec3(30, -20, 9.5)},
+      {Vec3(26, -20, 0), Vec3(38, 12, 13.0)}, {Vec3(-40, -20, 0), Vec3(-27, 18, 10.0)},
       {Vec3(34, 30, 0), Vec3(64, 52, 22.0)},
   };
   for (const Building& bd : buildings) {
@@ -112,10 +114,14 @@ void addOuterRing(WorldBuilder& b, Rng& rng, layout::KeepOut& keep) {
     const Vec2 half = kind == 0 ? Vec2(2.3, 2.3) : Vec2(0.5, 0.5);
     if (!keep.clear(c, half, lo, hi)) continue;
     keep.lanes.push_back({c, c});  // later pieces keep their distance
-    if (kind == 0) addTree(b, rng, c);
-    else if (kind == 1) addLamp(b, c);
-    else if (kind == 2) kit::addBin(b, rng, c);
-    else kit::addPlant(b, rng, c, 1.6);
+    if (kind == 0)
+      addTree(b, rng, c);
+    else if (kind == 1)
+      addLamp(b, c);
+    else if (kind == 2)
+      kit::addBin(b, rng, c);
+    else
+      kit::addPlant(b, rng, c, 1.6);
     ++placed;
   }
   for (double x = -20.0; x < 20.0; x += rng.uniform(5.5, 8.0)) addCar(b, rng, Vec2(x, -15.0), 0.0);

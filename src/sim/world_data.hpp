@@ -13,12 +13,12 @@ namespace mcslam::sim::detail {
 
 // One face's appearance after the materials have been resolved to textures.
 struct FaceRecord {
-  int32_t texture = -1;         // index in WorldData::textures, -1 = uniform albedo
-  float su = 0, sv = 0;         // texels per metre along the face's u and v
-  float ou = 0, ov = 0;         // texel offsets (so faces sharing a texture show different parts)
-  float albedo = 0.5f;          // linear albedo (uniform) or factor on the texture's albedo
+  int32_t texture = -1;  // index in WorldData::textures, -1 = uniform albedo
+  float su = 0, sv = 0;  // texels per metre along the face's u and v
+  float ou = 0, ov = 0;  // texel offsets (so faces sharing a texture show different parts)
+  float albedo = 0.5f;   // linear albedo (uniform) or factor on the texture's albedo
   float emission = 0.f;
-  int32_t lightmap = -1;        // index in WorldData::lightmaps, -1 = shaded from its normal
+  int32_t lightmap = -1;  // index in WorldData::lightmaps, -1 = shaded from its normal
 
   // Box faces only, precomputed for the renderer: with q the local hit point, texture coordinates are
   // (q[axis_u] * tex_u[0] + tex_u[1], q[axis_v] * tex_v[0] + tex_v[1]) and light-map cell coordinates likewise;
@@ -29,16 +29,16 @@ struct FaceRecord {
 };
 
 struct LightmapRecord {
-  std::size_t offset = 0;       // into WorldData::lightmap_values
-  int w = 0, h = 0;             // cells along u and v
-  float su = 5.f, sv = 5.f;     // cells per metre along u and v
+  std::size_t offset = 0;    // into WorldData::lightmap_values
+  int w = 0, h = 0;          // cells along u and v
+  float su = 5.f, sv = 5.f;  // cells per metre along u and v
 };
 
 struct WorldData {
   std::string name = "custom";
   uint64_t seed = 1;
 
-  std::vector<Prim> prims;             // static objects, builder order
+  std::vector<Prim> prims;               // static objects, builder order
   std::vector<Material> face_materials;  // as given to the builder (one per face)
   std::vector<FaceRecord> faces;
   std::vector<MipTexture> textures;

@@ -44,8 +44,9 @@ Room corridor(WorldBuilder& b, Rng& rng, const Vec2& lo, const Vec2& hi, bool al
   kit::addCeiling(b, lo, hi, kHeight, Material::texture(TextureKind::CeilingTiles, 1.0, 0.0023));
   const double len = along_x ? hi.x() - lo.x() : hi.y() - lo.y();
   for (double s = 1.8; s < len - 1.0; s += 3.5) {
-    kit::addCeilingLight(b, along_x ? Vec2(lo.x() + s, 0.5 * (lo.y() + hi.y())) : Vec2(0.5 * (lo.x() + hi.x()), lo.y() + s),
-                         kHeight, 5.0);
+    kit::addCeilingLight(
+        b, along_x ? Vec2(lo.x() + s, 0.5 * (lo.y() + hi.y())) : Vec2(0.5 * (lo.x() + hi.x()), lo.y() + s), kHeight,
+        5.0);
   }
   (void)rng;
   return r;
@@ -56,8 +57,10 @@ void furnishOffice(WorldBuilder& b, Room& room, Rng& rng, const layout::KeepOut&
     kit::addDesk(b, rng, c, yaw + M_PI);  // desks face the wall, chairs on the room side
   });
   layout::fillWallSlots(room, rng, keep, 0.9, 0.45, 0.3, 0.9, [&](const Vec2& c, double yaw) {
-    if (rng.chance(0.5)) kit::addBookshelf(b, rng, c, yaw, 0.9, rng.uniform(1.6, 2.1));
-    else kit::addCabinet(b, rng, c, yaw, 0.9, 0.45, rng.uniform(0.75, 1.3));
+    if (rng.chance(0.5))
+      kit::addBookshelf(b, rng, c, yaw, 0.9, rng.uniform(1.6, 2.1));
+    else
+      kit::addCabinet(b, rng, c, yaw, 0.9, 0.45, rng.uniform(0.75, 1.3));
   });
 }
 
@@ -65,9 +68,8 @@ void furnishStorage(WorldBuilder& b, Room& room, Rng& rng, const layout::KeepOut
   layout::fillWallSlots(room, rng, keep, 1.0, 0.4, 0.2, 0.9, [&](const Vec2& c, double yaw) {
     kit::addBookshelf(b, rng, c, yaw, 1.0, rng.uniform(1.8, 2.2));
   });
-  layout::fillWallSlots(room, rng, keep, 0.6, 0.6, 0.4, 0.8, [&](const Vec2& c, double yaw) {
-    kit::addCrates(b, rng, c, yaw);
-  });
+  layout::fillWallSlots(room, rng, keep, 0.6, 0.6, 0.4, 0.8,
+                        [&](const Vec2& c, double yaw) { kit::addCrates(b, rng, c, yaw); });
   for (int tries = 0; tries < 30; ++tries) {  // a work bench in a free spot
     const Vec2 c(rng.uniform(room.lo.x() + 1.5, room.hi.x() - 1.5), rng.uniform(room.lo.y() + 1.5, room.hi.y() - 1.5));
     if (keep.clear(c, Vec2(1.0, 0.5), room.lo, room.hi)) {
@@ -79,12 +81,13 @@ void furnishStorage(WorldBuilder& b, Room& room, Rng& rng, const layout::KeepOut
 }
 
 void furnishLounge(WorldBuilder& b, Room& room, Rng& rng, const layout::KeepOut& keep) {
-  layout::fillWallSlots(room, rng, keep, 2.0, 0.9, 0.8, 0.9, [&](const Vec2& c, double yaw) {
-    kit::addSofa(b, rng, c, yaw, 1.9);
-  });
+  layout::fillWallSlots(room, rng, keep, 2.0, 0.9, 0.8, 0.9,
+                        [&](const Vec2& c, double yaw) { kit::addSofa(b, rng, c, yaw, 1.9); });
   layout::fillWallSlots(room, rng, keep, 0.8, 0.8, 0.5, 0.9, [&](const Vec2& c, double yaw) {
-    if (rng.chance(0.6)) kit::addPlant(b, rng, c, rng.uniform(1.0, 1.8));
-    else kit::addBookshelf(b, rng, c, yaw, 0.8, 1.2);
+    if (rng.chance(0.6))
+      kit::addPlant(b, rng, c, rng.uniform(1.0, 1.8));
+    else
+      kit::addBookshelf(b, rng, c, yaw, 0.8, 1.2);
   });
   for (int n = 0, tries = 0; tries < 40 && n < 2; ++tries) {  // low tables in free spots
     const Vec2 c(rng.uniform(room.lo.x() + 1.2, room.hi.x() - 1.2), rng.uniform(room.lo.y() + 1.2, room.hi.y() - 1.2));
@@ -108,8 +111,10 @@ void furnishMeeting(WorldBuilder& b, Room& room, Rng& rng, const layout::KeepOut
     }
   }
   layout::fillWallSlots(room, rng, keep, 0.8, 0.5, 1.0, 0.8, [&](const Vec2& c, double yaw) {
-    if (rng.chance(0.5)) kit::addCabinet(b, rng, c, yaw, 0.8, 0.5, 0.9);
-    else kit::addPlant(b, rng, c, 1.4);
+    if (rng.chance(0.5))
+      kit::addCabinet(b, rng, c, yaw, 0.8, 0.5, 0.9);
+    else
+      kit::addPlant(b, rng, c, 1.4);
   });
 }
 
@@ -119,10 +124,14 @@ void decorateCorridor(WorldBuilder& b, Room& corr, Rng& rng) {
     kit::addSkirting(b, rw.wall, true, 0.0, len);
     for (double s = rng.uniform(1.0, 2.5); s < len - 1.5; s += rng.uniform(2.5, 4.5)) {
       const int kind = rng.integer(0, 3);
-      if (kind == 0) kit::addDoor(b, rw.wall, true, s, 0.9);
-      else if (kind == 1) kit::addPoster(b, rw.wall, true, s, 1.5, 0.6, 0.85);
-      else if (kind == 2) kit::addNoticeBoard(b, rw.wall, true, s, 1.45, 1.2, 0.7);
-      else kit::addRadiator(b, rw.wall, true, s, 1.0);
+      if (kind == 0)
+        kit::addDoor(b, rw.wall, true, s, 0.9);
+      else if (kind == 1)
+        kit::addPoster(b, rw.wall, true, s, 1.5, 0.6, 0.85);
+      else if (kind == 2)
+        kit::addNoticeBoard(b, rw.wall, true, s, 1.45, 1.2, 0.7);
+      else
+        kit::addRadiator(b, rw.wall, true, s, 1.0);
     }
   }
 }
@@ -146,31 +155,34 @@ std::shared_ptr<const World> buildIndoorWorld(const WorldOptions& options) {
   Room B = layout::makeRoom(Vec2(23, 0), Vec2(32, 8), kHeight, {true, true, false, false});
   Room C = layout::makeRoom(Vec2(23, 16), Vec2(32, 24), kHeight, {false, true, true, false});
   Room D = layout::makeRoom(Vec2(0, 16), Vec2(9, 24), kHeight, {false, false, true, true});
-  const double c0 = 4.0 - kCorridorHalf, c1 = 4.0 + kCorridorHalf;      // corridor S/N across y, E/W across x
+  const double c0 = 4.0 - kCorridorHalf, c1 = 4.0 + kCorridorHalf;  // corridor S/N across y, E/W across x
   auto opening = [](double from, double to) { return Opening{from, to, 0.0, 2.4}; };
-  A.walls[1].openings.push_back(opening(c0, c1));                          // east -> corridor S
-  A.walls[2].openings.push_back(opening(9 - 5.8, 9 - 3.2));                // north -> corridor W
-  B.walls[3].openings.push_back(opening(8 - c1, 8 - c0));                  // west -> corridor S
-  B.walls[2].openings.push_back(opening(32 - 28.8, 32 - 26.2));            // north -> corridor E
-  C.walls[0].openings.push_back(opening(26.2 - 23, 28.8 - 23));            // south -> corridor E
-  C.walls[3].openings.push_back(opening(24 - 21.3, 24 - 18.7));            // west -> corridor N
-  D.walls[1].openings.push_back(opening(18.7 - 16, 21.3 - 16));            // east -> corridor N
-  D.walls[0].openings.push_back(opening(3.2, 5.8));                        // south -> corridor W
+  A.walls[1].openings.push_back(opening(c0, c1));                // east -> corridor S
+  A.walls[2].openings.push_back(opening(9 - 5.8, 9 - 3.2));      // north -> corridor W
+  B.walls[3].openings.push_back(opening(8 - c1, 8 - c0));        // west -> corridor S
+  B.walls[2].openings.push_back(opening(32 - 28.8, 32 - 26.2));  // north -> corridor E
+  C.walls[0].openings.push_back(opening(26.2 - 23, 28.8 - 23));  // south -> corridor E
+  C.walls[3].openings.push_back(opening(24 - 21.3, 24 - 18.7));  // west -> corridor N
+  D.walls[1].openings.push_back(opening(18.7 - 16, 21.3 - 16));  // east -> corridor N
+  D.walls[0].openings.push_back(opening(3.2, 5.8));              // south -> corridor W
 
   const Material outside = Material::unseen();
   const Material ceiling = Material::texture(TextureKind::CeilingTiles, 1.0, 0.0023);
   layout::buildRoom(b, A, paint(rng), outside, Material::texture(TextureKind::Carpet, 1.0, 0.002), ceiling, 3.5, 6.0);
   layout::buildRoom(b, B, Material::texture(TextureKind::Brick, 1.0, 0.0022), outside,
                     Material::texture(TextureKind::Tiles, 1.0, 0.002), ceiling, 3.5, 6.0);
-  layout::buildRoom(b, C, paint(rng), outside, Material::texture(TextureKind::WoodPlanks, 1.0, 0.0022), ceiling, 3.5, 6.0);
+  layout::buildRoom(b, C, paint(rng), outside, Material::texture(TextureKind::WoodPlanks, 1.0, 0.0022), ceiling, 3.5,
+                    6.0);
   layout::buildRoom(b, D, Material::texture(TextureKind::Concrete, 1.1, 0.002), outside,
                     Material::texture(TextureKind::Carpet, 0.8, 0.002), ceiling, 3.5, 6.0);
 
-  Room S = corridor(b, rng, Vec2(9, c0), Vec2(23, c1), true, paint(rng), Material::texture(TextureKind::Linoleum, 1.0, 0.002));
+  Room S = corridor(b, rng, Vec2(9, c0), Vec2(23, c1), true, paint(rng),
+                    Material::texture(TextureKind::Linoleum, 1.0, 0.002));
   Room N = corridor(b, rng, Vec2(9, 20 - kCorridorHalf), Vec2(23, 20 + kCorridorHalf), true, paint(rng),
                     Material::texture(TextureKind::Tiles, 0.9, 0.002));
   Room E = corridor(b, rng, Vec2(27.5 - kCorridorHalf, 8), Vec2(27.5 + kCorridorHalf, 16), false,
-                    Material::texture(TextureKind::Concrete, 1.0, 0.002), Material::texture(TextureKind::Linoleum, 1.0, 0.002));
+                    Material::texture(TextureKind::Concrete, 1.0, 0.002),
+                    Material::texture(TextureKind::Linoleum, 1.0, 0.002));
   Room W = corridor(b, rng, Vec2(4.5 - kCorridorHalf, 8), Vec2(4.5 + kCorridorHalf, 16), false, paint(rng),
                     Material::texture(TextureKind::Linoleum, 0.8, 0.002));
 

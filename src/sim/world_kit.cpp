@@ -53,7 +53,7 @@ void addWall(WorldBuilder& b, const Wall& w, const Material& left, const Materia
   const double len = w.length(), yaw = std::atan2(w.dir().y(), w.dir().x());
   std::array<Material, 6> faces;
   faces.fill(left);
-  faces[kBoxMinusY] = right;  // the local +y face looks to the left of a->b
+  faces[kBoxMinusY] = right;             // the local +y face looks to the left of a->b
   const double ext = 0.5 * w.thickness;  // ends overlap the walls they meet: no cracks at corners
   auto piece = [&](double from, double to, double z0, double z1) {
     if (to - from < 1e-4 || z1 - z0 < 1e-4) return;
@@ -83,7 +83,8 @@ void addCeiling(WorldBuilder& b, const Vec2& lo, const Vec2& hi, double height, 
 }
 
 void addCeilingLight(WorldBuilder& b, const Vec2& at, double height, double intensity) {
-  b.addBox(Vec3(at.x() - 0.3, at.y() - 0.3, height - 0.02), Vec3(at.x() + 0.3, at.y() + 0.3, height), Material::lamp(2.5));
+  b.addBox(Vec3(at.x() - 0.3, at.y() - 0.3, height - 0.02), Vec3(at.x() + 0.3, at.y() + 0.3, height),
+           Material::lamp(2.5));
   b.addLight({Vec3(at.x(), at.y(), height - 0.1), intensity, 0.25, 12.0});
 }
 
@@ -92,19 +93,22 @@ void addPoster(WorldBuilder& b, const Wall& w, bool left_side, double along, dou
             Material::uniform(0.8));
 }
 
-void addNoticeBoard(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width, double height) {
+void addNoticeBoard(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width,
+                    double height) {
   wallPanel(b, w, left_side, along, z, width, height, 0.02, Material::fitted(TextureKind::NoticeBoard),
             Material::uniform(0.5));
 }
 
-void addWhiteboard(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width, double height) {
+void addWhiteboard(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width,
+                   double height) {
   wallPanel(b, w, left_side, along, z, width, height, 0.015, Material::fitted(TextureKind::Whiteboard),
             Material::uniform(0.6));
 }
 
 void addDoor(WorldBuilder& b, const Wall& w, bool left_side, double along, double width) {
   const double h = 2.05;
-  wallPanel(b, w, left_side, along, 0.5 * h, width, h, 0.03, Material::fitted(TextureKind::Door), Material::uniform(0.5));
+  wallPanel(b, w, left_side, along, 0.5 * h, width, h, 0.03, Material::fitted(TextureKind::Door),
+            Material::uniform(0.5));
   const Material frame = Material::uniform(0.25);
   const double fw = 0.06;  // frame: two jambs and a head
   wallPanel(b, w, left_side, along - 0.5 * width - 0.5 * fw, 0.5 * (h + fw), fw, h + fw, 0.045, frame, frame);
@@ -197,7 +201,8 @@ void addPlant(WorldBuilder& b, Rng& rng, const Vec2& c, double height) {
                 Material::texture(TextureKind::Concrete, rng.uniform(0.6, 1.2), 0.001), Material::uniform(0.15));
   const double h = std::max(0.3, height - 0.36);
   b.addCylinder(SE3(yawMatrix(rng.uniform(0, 2 * M_PI)), Vec3(c.x(), c.y(), 0.36 + 0.5 * h)), 0.36, 0.5 * h,
-                Material::texture(TextureKind::Foliage, 1.0, 0.0012), Material::texture(TextureKind::Foliage, 1.0, 0.0012));
+                Material::texture(TextureKind::Foliage, 1.0, 0.0012),
+                Material::texture(TextureKind::Foliage, 1.0, 0.0012));
 }
 
 void addBin(WorldBuilder& b, Rng& rng, const Vec2& c) {
@@ -210,7 +215,8 @@ void addCrates(WorldBuilder& b, Rng& rng, const Vec2& c, double yaw) {
     const double w = rng.uniform(0.35, 0.6), d = rng.uniform(0.3, 0.5), h = rng.uniform(0.25, 0.45);
     const Material body = Material::texture(TextureKind::WoodPanel, rng.uniform(0.5, 0.9), 0.003);
     partWithFront(b, c, yaw, Vec3(rng.uniform(-0.04, 0.04), rng.uniform(-0.04, 0.04), z + 0.5 * h),
-                  Vec3(0.5 * d, 0.5 * w, 0.5 * h), body, Material::fitted(TextureKind::Poster, 500 + rng.integer(0, 7)));
+                  Vec3(0.5 * d, 0.5 * w, 0.5 * h), body,
+                  Material::fitted(TextureKind::Poster, 500 + rng.integer(0, 7)));
     z += h;
   }
 }

@@ -10,8 +10,8 @@
 namespace mcslam::sim::kit {
 
 struct Opening {
-  double from = 0, to = 1;        // metres along the wall from its start
-  double bottom = 0, top = 2.1;   // doorway: 0..2.1; window: e.g. 0.9..2.0
+  double from = 0, to = 1;       // metres along the wall from its start
+  double bottom = 0, top = 2.1;  // doorway: 0..2.1; window: e.g. 0.9..2.0
 };
 
 // A straight wall from a to b (floor plan), `left` material on the side to the left of a->b.
@@ -36,7 +36,8 @@ void addCeilingLight(WorldBuilder& b, const Vec2& at, double height, double inte
 
 // Wall decorations: thin panels on one side of a wall, centred `along` metres from its start at height z.
 void addPoster(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width, double height);
-void addNoticeBoard(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width, double height);
+void addNoticeBoard(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width,
+                    double height);
 void addWhiteboard(WorldBuilder& b, const Wall& w, bool left_side, double along, double z, double width, double height);
 // Closed door with frame (the wall behind it stays solid).
 void addDoor(WorldBuilder& b, const Wall& w, bool left_side, double along, double width = 0.9);

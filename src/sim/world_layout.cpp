@@ -41,7 +41,8 @@ double boxDistance(const Vec2& p, const Vec2& c, const Vec2& half) {
 }  // namespace
 
 bool KeepOut::clear(const Vec2& c, const Vec2& half, const Vec2& lo, const Vec2& hi) const {
-  if (c.x() - half.x() < lo.x() || c.y() - half.y() < lo.y() || c.x() + half.x() > hi.x() || c.y() + half.y() > hi.y()) {
+  if (c.x() - half.x() < lo.x() || c.y() - half.y() < lo.y() || c.x() + half.x() > hi.x() ||
+      c.y() + half.y() > hi.y()) {
     return false;
   }
   if (route) {
@@ -58,9 +59,8 @@ bool KeepOut::clear(const Vec2& c, const Vec2& half, const Vec2& lo, const Vec2&
   return true;
 }
 
-int fillWallSlots(Room& room, Rng& rng, const KeepOut& keep_out, double width, double depth,
-                  double spacing, double keep_probability,
-                  const std::function<void(const Vec2& centre, double yaw)>& place) {
+int fillWallSlots(Room& room, Rng& rng, const KeepOut& keep_out, double width, double depth, double spacing,
+                  double keep_probability, const std::function<void(const Vec2& centre, double yaw)>& place) {
   int placed = 0;
   for (RoomWall& rw : room.walls) {
     const kit::Wall& w = rw.wall;
@@ -89,12 +89,12 @@ void decorateWalls(WorldBuilder& b, Room& room, Rng& rng, int items_per_wall) {
       const int kind = rw.exterior ? rng.integer(0, 5) : rng.integer(0, 4);
       double width = 0, from = 0;
       switch (kind) {
-        case 0: width = rng.uniform(0.45, 0.8); break;   // poster
-        case 1: width = rng.uniform(1.0, 1.8); break;    // notice board
-        case 2: width = rng.uniform(1.2, 2.2); break;    // whiteboard
-        case 3: width = 1.0; break;                      // door (with frame)
-        case 4: width = rng.uniform(0.45, 0.8); break;   // poster
-        default: width = rng.uniform(1.0, 1.8); break;   // window
+        case 0: width = rng.uniform(0.45, 0.8); break;  // poster
+        case 1: width = rng.uniform(1.0, 1.8); break;   // notice board
+        case 2: width = rng.uniform(1.2, 2.2); break;   // whiteboard
+        case 3: width = 1.0; break;                     // door (with frame)
+        case 4: width = rng.uniform(0.45, 0.8); break;  // poster
+        default: width = rng.uniform(1.0, 1.8); break;  // window
       }
       bool found = false;
       for (int tries = 0; tries < 12 && !found; ++tries) {

@@ -44,9 +44,8 @@ struct KeepOut {
 // Places pieces against the room's walls, every `spacing` metres, each facing into the room. place(centre, yaw)
 // adds the piece; depth/width are its size across/along the wall. Slots too close to the route or to openings
 // or lanes, or to openings, are skipped. Returns how many were placed.
-int fillWallSlots(Room& room, Rng& rng, const KeepOut& keep_out, double width, double depth,
-                  double spacing, double keep_probability,
-                  const std::function<void(const Vec2& centre, double yaw)>& place);
+int fillWallSlots(Room& room, Rng& rng, const KeepOut& keep_out, double width, double depth, double spacing,
+                  double keep_probability, const std::function<void(const Vec2& centre, double yaw)>& place);
 
 // Decorates the room's walls: posters, notice boards, whiteboards, doors, windows with radiators (exterior
 // walls), skirting boards.

@@ -3,11 +3,11 @@
 // world points, projected through the full camera models with pixel noise, and a driver that
 // slides the solver's window along such a sequence as the odometry will.
 // Header-only so that tests/bench can share it without another library.
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
-#include <Eigen/Eigenvalues>
 #include <string>
 #include <vector>
 
@@ -38,15 +38,15 @@ struct SceneOptions {
   int max_octave = 3;                // sigma = 1.2^octave, octave uniform in [0, max_octave]
   int track_min = 3, track_max = 8;  // keyframes a landmark stays trackable (features get lost)
   double detection_probability = 0.8;
-  double outlier_fraction = 0.0;     // observations moved by `outlier_pixels`
+  double outlier_fraction = 0.0;  // observations moved by `outlier_pixels`
   double outlier_pixels = 20.0;
   unsigned seed = 1;
 };
 
 struct Scene {
-  Rig rig;                       // the true rig
-  std::vector<SE3> T_w_b;        // true poses
-  std::vector<Vec3> points;      // true landmarks
+  Rig rig;                   // the true rig
+  std::vector<SE3> T_w_b;    // true poses
+  std::vector<Vec3> points;  // true landmarks
   std::vector<SceneObservation> observations;
   std::vector<std::vector<int>> observations_of_keyframe;
   std::vector<std::vector<int>> observations_of_landmark;
@@ -189,14 +189,14 @@ struct SlidingRunOptions {
   int iterations = 10;
   double new_pose_trans = 0.02;  // error of the tracking pose given for a new keyframe
   double new_pose_rot = 0.005;
-  double new_point_sigma = 0.05; // error of a new landmark's triangulation
-  bool remove_outliers = true;   // drop what the solver flags, as the odometry will
-  bool check_prior = false;      // symmetry and eigenvalues of the prior (allocates)
+  double new_point_sigma = 0.05;  // error of a new landmark's triangulation
+  bool remove_outliers = true;    // drop what the solver flags, as the odometry will
+  bool check_prior = false;       // symmetry and eigenvalues of the prior (allocates)
   unsigned seed = 7;
 };
 
 struct SlidingRunResult {
-  std::vector<SE3> T_w_b;          // each keyframe's estimate when it left the window (or at the end)
+  std::vector<SE3> T_w_b;             // each keyframe's estimate when it left the window (or at the end)
   std::vector<uint64_t> allocations;  // heap allocations during each keyframe's step
   int marginalizations = 0;
   int solves = 0;

@@ -21,9 +21,7 @@ inline void toParams(const SE3& T, double* x) {
   x[0] = T.t.x(), x[1] = T.t.y(), x[2] = T.t.z();
   x[3] = q.x(), x[4] = q.y(), x[5] = q.z(), x[6] = q.w();
 }
-inline SE3 fromParams(const double* x) {
-  return {Eigen::Quaterniond(x[6], x[3], x[4], x[5]), Vec3(x[0], x[1], x[2])};
-}
+inline SE3 fromParams(const double* x) { return {Eigen::Quaterniond(x[6], x[3], x[4], x[5]), Vec3(x[0], x[1], x[2])}; }
 
 class SE3RightManifold : public ceres::Manifold {
  public:
@@ -148,8 +146,8 @@ inline std::unique_ptr<CeresWindow> buildCeresWindow(const Scene& scene, const W
   for (const SceneObservation& ob : scene.observations) {
     if (scene.num_observations[ob.landmark] < 2) continue;
     w->problem->AddResidualBlock(new ReprojectionCost(&scene.rig.cameras[ob.camera].model, ob.uv, ob.sigma),
-                                 makeLoss(options.loss), w->poses[ob.keyframe].data(),
-                                 w->extrinsics[ob.camera].data(), w->points[ob.landmark].data());
+                                 makeLoss(options.loss), w->poses[ob.keyframe].data(), w->extrinsics[ob.camera].data(),
+                                 w->points[ob.landmark].data());
   }
   for (auto& p : w->poses) w->problem->SetManifold(p.data(), &manifold);
   for (int c = 0; c < solver_rig.size(); ++c) {

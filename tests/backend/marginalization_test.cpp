@@ -149,7 +149,8 @@ TEST(Marginalization, WithoutExclusiveLandmarksThePriorStaysEmpty) {
   solver.solve(10);
   const int observations = solver.numObservations();
   int of_oldest = 0;
-  for (int idx : scene.observations_of_keyframe[0]) of_oldest += scene.num_observations[scene.observations[idx].landmark] >= 2;
+  for (int idx : scene.observations_of_keyframe[0])
+    of_oldest += scene.num_observations[scene.observations[idx].landmark] >= 2;
   ASSERT_EQ(solver.marginalizeOldest(), Status::Ok);
   EXPECT_EQ(solver.priorInformation().size(), 0);
   EXPECT_EQ(solver.numKeyframes(), 9);

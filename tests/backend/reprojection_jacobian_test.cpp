@@ -102,8 +102,9 @@ TEST(ExtrinsicPriorJacobian, MatchesNumericAndVanishesAtCalibration) {
   const ExtrinsicPriorSigmas sigmas{0.02, 0.01};
   for (int trial = 0; trial < 30; ++trial) {
     const SE3 calib(so3Exp(Vec3(u(rng), u(rng), u(rng))), Vec3(u(rng), u(rng), u(rng)));
-    const SE3 T = calib * SE3::exp((Vec6() << 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng), 0.2 * u(rng),
-                                    0.2 * u(rng), 0.2 * u(rng)).finished());
+    const SE3 T = calib * SE3::exp((Vec6() << 0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng), 0.2 * u(rng), 0.2 * u(rng),
+                                    0.2 * u(rng))
+                                       .finished());
     Mat6 J;
     extrinsicPriorResidual(calib, T, sigmas, nullptr, &J);
     const Eigen::MatrixXd Jn = numericJacobian(

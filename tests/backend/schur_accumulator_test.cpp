@@ -123,14 +123,13 @@ TEST_P(SchurAccumulatorTest, ReducedSolveEqualsTheDenseSolve) {
     EXPECT_LT((xc - x.head(6 * pb.blocks)).norm(), 1e-8 * (1 + x.norm())) << "seed " << seed;
     // The reduced matrix is the Schur complement H_cc - H_cp H_pp^-1 H_pc.
     const int n = 6 * pb.blocks, m = 3 * pb.points;
-    const Eigen::MatrixXd Sc =
-        H.topLeftCorner(n, n) - H.topRightCorner(n, m) * H.bottomRightCorner(m, m).ldlt().solve(H.bottomLeftCorner(m, n));
+    const Eigen::MatrixXd Sc = H.topLeftCorner(n, n) - H.topRightCorner(n, m) * H.bottomRightCorner(m, m).ldlt().solve(
+                                                                                    H.bottomLeftCorner(m, n));
     EXPECT_LT((S - Sc).norm(), 1e-9 * Sc.norm()) << "seed " << seed;
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Modes, SchurAccumulatorTest,
-                         ::testing::Combine(::testing::Bool(), ::testing::Bool()));
+INSTANTIATE_TEST_SUITE_P(Modes, SchurAccumulatorTest, ::testing::Combine(::testing::Bool(), ::testing::Bool()));
 
 TEST(SchurAccumulator, PatternMarksTheUpperBlocksAPointLinks) {
   SchurAccumulator acc(4, 4);

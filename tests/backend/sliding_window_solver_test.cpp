@@ -63,9 +63,9 @@ TEST(SlidingWindowSolver, NoisyWindowConvergesToGroundTruth) {
 TEST(SlidingWindowSolver, EquidistantRigConverges) {
   // A two-fisheye rig (TUM-VI style), looking forward with a 10 cm baseline.
   Rig rig;
-  const CameraModel fisheye(512, 512, 190.97, 190.97, 254.93, 256.89, Distortion::Equidistant,
-                            {0.0034823894022493434, 0.0007150348452162257, -0.0020532361418706202,
-                             0.00020293673591811182});
+  const CameraModel fisheye(
+      512, 512, 190.97, 190.97, 254.93, 256.89, Distortion::Equidistant,
+      {0.0034823894022493434, 0.0007150348452162257, -0.0020532361418706202, 0.00020293673591811182});
   rig.cameras.push_back({"cam0", fisheye, SE3(), 0});
   rig.cameras.push_back({"cam1", fisheye, SE3(so3Exp(Vec3(0, 0.02, 0)), Vec3(0.1, 0, 0)), 1});
   SceneOptions so;

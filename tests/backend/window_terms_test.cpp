@@ -258,8 +258,7 @@ TEST(WindowTerms, MarginalizationPriorForgetsAnExtrinsicByItsSchurComplement) {
   term.forgetExtrinsic(2, f.window);  // variable 1: rows 6..11
   EXPECT_FALSE(f.window.extrinsics[2].in_prior);
   EXPECT_EQ((term.H.middleRows<6>(6).norm()), 0.0);
-  const Eigen::MatrixXd expected =
-      H - H.middleCols<6>(6) * H.block<6, 6>(6, 6).inverse() * H.middleRows<6>(6);
+  const Eigen::MatrixXd expected = H - H.middleCols<6>(6) * H.block<6, 6>(6, 6).inverse() * H.middleRows<6>(6);
   Eigen::MatrixXd got = term.H;
   got.middleRows<6>(6).setZero();
   Eigen::MatrixXd want = expected;

@@ -44,7 +44,8 @@ const BenchWindow& benchWindow() {
     b.options.gradient_tolerance = 0;
     b.options.parameter_tolerance = 0;
     for (size_t l = 0; l < b.scene.points.size(); ++l) b.landmarks += b.scene.num_observations[l] >= 2;
-    for (const SceneObservation& ob : b.scene.observations) b.observations += b.scene.num_observations[ob.landmark] >= 2;
+    for (const SceneObservation& ob : b.scene.observations)
+      b.observations += b.scene.num_observations[ob.landmark] >= 2;
     return b;
   }();
   return w;

@@ -22,8 +22,8 @@
 #include <opencv2/features2d.hpp>
 
 #include <chrono>
-#include <ctime>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <vector>
 
@@ -66,7 +66,7 @@ struct Subset {
 };
 
 const std::vector<Subset>& subsets() {
-  static const std::vector<Subset> s = {{"1OV", {2}},          {"2OV", {1, 2}},       {"3OV", {1, 2, 3}},
+  static const std::vector<Subset> s = {{"1OV", {2}},          {"2OV", {1, 2}},          {"3OV", {1, 2, 3}},
                                         {"4OV", {0, 1, 2, 3}}, {"5OV", {0, 1, 2, 3, 4}}, {"3NOV", {2, 5, 6}}};
   return s;
 }
@@ -154,8 +154,8 @@ void FrontEnd5CamCvOrb(benchmark::State& state) {
   FrameFeatures f(rig.size(), config.orb.max_features);
   std::vector<cv::Ptr<cv::ORB>> orbs;
   for (int c = 0; c < rig.size(); ++c) {
-    orbs.push_back(cv::ORB::create(config.orb.max_features, static_cast<float>(config.orb.scale_factor),
-                                   config.orb.levels));
+    orbs.push_back(
+        cv::ORB::create(config.orb.max_features, static_cast<float>(config.orb.scale_factor), config.orb.levels));
   }
   std::vector<std::vector<cv::KeyPoint>> keypoints(rig.size());
   std::vector<cv::Mat> descriptors(rig.size());
@@ -223,8 +223,16 @@ static const bool kRegistered = [] {
   }
   return true;
 }();
-BENCHMARK(FrontEnd5CamMcslam)->Name("FrontEnd5Cam/mcslam")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3 * kFrames);
-BENCHMARK(FrontEnd5CamCvOrb)->Name("FrontEnd5Cam/cv_orb")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3 * kFrames);
+BENCHMARK(FrontEnd5CamMcslam)
+    ->Name("FrontEnd5Cam/mcslam")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3 * kFrames);
+BENCHMARK(FrontEnd5CamCvOrb)
+    ->Name("FrontEnd5Cam/cv_orb")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3 * kFrames);
 BENCHMARK(FrontEnd5CamAlignedMcslam)
     ->Name("FrontEnd5CamAligned/mcslam")
     ->Unit(benchmark::kMillisecond)

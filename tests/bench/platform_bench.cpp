@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "../platform/sim_dataset_fixture.hpp"
 #include "daemon/daemon.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/dataset/dataset.hpp"
@@ -25,7 +26,6 @@
 #include "mcslam/pose_shm.hpp"
 #include "shm/pose_shm_writer.hpp"
 #include "test_support.hpp"
-#include "../platform/sim_dataset_fixture.hpp"
 
 using namespace mcslam;
 
@@ -132,7 +132,8 @@ void BM_TriggerToPose5Cam20Hz_mcslam(benchmark::State& state) {
     const platform::DaemonConfig c = platform::parseDaemonConfig(
         "source:\n  type: dataset\n  dataset:\n    path: " + data +
             "\n    at_end: idle\n    preload: true\ntrigger:\n  mode: software\n  rate_hz: 20\n"
-            "warmup_frames: 20\npublish:\n  shm:\n    name: /mcslam-bench-daemon-" + std::to_string(getpid()) +
+            "warmup_frames: 20\npublish:\n  shm:\n    name: /mcslam-bench-daemon-" +
+            std::to_string(getpid()) +
             "\n  udp:\n    destinations: [\"127.0.0.1:9\"]\noutput:\n  directory: " + dir.path().string() + "\n",
         dir.file("bench.yaml"));
     platform::Daemon d(c, createPipeline(c.slam, c.file, c.rig));
@@ -181,7 +182,25 @@ void BM_TriggerToPose5Cam20Hz_direct_call(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_ShmPublishToRead_mcslam)->Name("ShmPublishToRead/mcslam")->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ShmPublishToRead_udp_loopback)->Name("ShmPublishToRead/udp_loopback")->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_TriggerToPose5Cam20Hz_mcslam)->Name("TriggerToPose5Cam20Hz/mcslam")->Arg(200)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_TriggerToPose5Cam20Hz_direct_call)->Name("TriggerToPose5Cam20Hz/direct_call")->Arg(200)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ShmPublishToRead_mcslam)
+    ->Name("ShmPublishToRead/mcslam")
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ShmPublishToRead_udp_loopback)
+    ->Name("ShmPublishToRead/udp_loopback")
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TriggerToPose5Cam20Hz_mcslam)
+    ->Name("TriggerToPose5Cam20Hz/mcslam")
+    ->Arg(200)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TriggerToPose5Cam20Hz_direct_call)
+    ->Name("TriggerToPose5Cam20Hz/direct_call")
+    ->Arg(200)
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);

@@ -47,6 +47,9 @@ void SimRenderIsec1Thread(benchmark::State& state) { renderImages(state, 1); }
 
 }  // namespace
 
-BENCHMARK(SimRenderIsec2Threads)->Name("SimRender/isec_720x540")->Unit(benchmark::kMillisecond)->UseRealTime()
+BENCHMARK(SimRenderIsec2Threads)
+    ->Name("SimRender/isec_720x540")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
     ->MinTime(3.0);
 BENCHMARK(SimRenderIsec1Thread)->Name("SimRender/isec_720x540_1thread")->Unit(benchmark::kMillisecond)->MinTime(3.0);

@@ -111,21 +111,20 @@ TEST(KalibrRig, BadCalibrationNamesFileCameraAndField) {
                  {"rig.yaml", "cam1", "intrinsics", "missing"});
   expectRejected(replaced(kTwoCams, "[400, 401, 320, 240]", "[400, 401, 320]"),
                  {"rig.yaml", "cam0", "intrinsics", "4 numbers", "got 3"});
-  expectRejected(replaced(kTwoCams, "camera_model: pinhole", "camera_model: omni"),
-                 {"cam0", "camera_model", "omni"});
+  expectRejected(replaced(kTwoCams, "camera_model: pinhole", "camera_model: omni"), {"cam0", "camera_model", "omni"});
   expectRejected(replaced(kTwoCams, "distortion_model: radtan", "distortion_model: fov"),
                  {"cam0", "distortion_model", "fov"});
   expectRejected(replaced(kTwoCams, "[-0.1, 0.01, 0.001, -0.001]", "[-0.1, abc, 0.001, -0.001]"),
                  {"cam0", "distortion_coeffs", "abc"});
-  expectRejected(replaced(kTwoCams, "- [1, 0, 0, -0.2]", "- [1, 0.5, 0, -0.2]"),
-                 {"cam1", "T_cn_cnm1", "rigid"});
+  expectRejected(replaced(kTwoCams, "- [1, 0, 0, -0.2]", "- [1, 0.5, 0, -0.2]"), {"cam1", "T_cn_cnm1", "rigid"});
   expectRejected(replaced(kTwoCams, "- [0, 0, 0, 1]", "- [0, 0, 1, 1]"), {"cam1", "T_cn_cnm1", "last row"});
   expectRejected(replaced(kTwoCams, "[640, 480]", "[640, 480.5]"), {"cam0", "resolution"});
   expectRejected(replaced(kTwoCams, "cam1:", "cam2:"), {"rig.yaml", "cam1", "missing"});
   expectRejected("something: 1\n", {"rig.yaml", "no cameras"});
   expectRejected("cam0: [unclosed\n", {"rig.yaml", "YAML"});
-  expectRejected(replaced(kTwoCams, "    - [1, 0, 0, -0.2]\n    - [0, 1, 0, 0]\n    - [0, 0, 1, 0]\n    - [0, 0, 0, 1]\n", ""),
-                 {"cam1", "T_cn_cnm1"});
+  expectRejected(
+      replaced(kTwoCams, "    - [1, 0, 0, -0.2]\n    - [0, 1, 0, 0]\n    - [0, 0, 1, 0]\n    - [0, 0, 0, 1]\n", ""),
+      {"cam1", "T_cn_cnm1"});
   try {
     loadKalibrRig("/nonexistent/rig.yaml");
     FAIL();

@@ -11,7 +11,8 @@ namespace {
 
 std::vector<Rig> allSharedRigs() {
   std::vector<Rig> rigs;
-  for (const char* f : {"isec_5cam_camchain.yaml", "euroc_kalibr_imucam_chain.yaml", "tumvi_kalibr_imucam_chain.yaml"}) {
+  for (const char* f :
+       {"isec_5cam_camchain.yaml", "euroc_kalibr_imucam_chain.yaml", "tumvi_kalibr_imucam_chain.yaml"}) {
     rigs.push_back(loadKalibrRig(test::dataPath(std::string("calib/") + f)));
   }
   rigs.push_back(loadEurocSensorRig(
@@ -39,9 +40,9 @@ TEST(CameraModel, RoundTripBelowMicroPixelOverWholeImage) {
       for (int y = 0; y <= cam.height() - 1; y += 3) {
         for (int x = 0; x <= cam.width() - 1; x += 3) worst = std::max(worst, roundTripError(cam, Vec2(x, y)));
       }
-      for (const Vec2& corner : {Vec2(0, 0), Vec2(cam.width() - 1, 0), Vec2(0, cam.height() - 1),
-                                Vec2(cam.width() - 1, cam.height() - 1), Vec2(-0.5, -0.5),
-                                Vec2(cam.width() - 0.5, cam.height() - 0.5)}) {
+      for (const Vec2& corner :
+           {Vec2(0, 0), Vec2(cam.width() - 1, 0), Vec2(0, cam.height() - 1), Vec2(cam.width() - 1, cam.height() - 1),
+            Vec2(-0.5, -0.5), Vec2(cam.width() - 0.5, cam.height() - 0.5)}) {
         worst = std::max(worst, roundTripError(cam, corner));
       }
       EXPECT_LT(worst, 1e-6) << rc.name << " " << distortionName(cam.distortion());

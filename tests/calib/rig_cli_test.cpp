@@ -30,8 +30,11 @@ TEST(RigCli, PerturbThenCompareGivesTheErrorBack) {
   test::TempDir dir("rig_cli");
   const std::string moved = dir.file("moved.yaml");
   std::string out;
-  ASSERT_EQ(test::runCommand(rigTool() + " perturb " + isecPath() + " --camera 3 --translation 0.02 --rotation-deg 1 --out " +
-                                 moved, &out), 0) << out;
+  ASSERT_EQ(test::runCommand(
+                rigTool() + " perturb " + isecPath() + " --camera 3 --translation 0.02 --rotation-deg 1 --out " + moved,
+                &out),
+            0)
+      << out;
   ASSERT_EQ(test::runCommand(rigTool() + " compare " + isecPath() + " " + moved, &out), 0) << out;
   EXPECT_NE(squeezed(out).find("cam3 20.00 1.0000"), std::string::npos) << out;
   EXPECT_NE(squeezed(out).find("cam2 0.00 0.0000"), std::string::npos) << out;
@@ -40,8 +43,12 @@ TEST(RigCli, PerturbThenCompareGivesTheErrorBack) {
 TEST(RigCli, BadCameraAndMismatchedRigsAreExplained) {
   test::TempDir dir("rig_cli");
   std::string out;
-  EXPECT_EQ(test::runCommand(rigTool() + " perturb " + isecPath() + " --camera 7 --out " + dir.file("x.yaml"), &out), 2);
+  EXPECT_EQ(test::runCommand(rigTool() + " perturb " + isecPath() + " --camera 7 --out " + dir.file("x.yaml"), &out),
+            2);
   EXPECT_NE(out.find("--camera 7: the rig has cameras 0..4"), std::string::npos) << out;
-  EXPECT_EQ(test::runCommand(rigTool() + " compare " + isecPath() + " " + test::dataPath("calib/euroc_kalibr_imucam_chain.yaml"), &out), 2);
+  EXPECT_EQ(
+      test::runCommand(
+          rigTool() + " compare " + isecPath() + " " + test::dataPath("calib/euroc_kalibr_imucam_chain.yaml"), &out),
+      2);
   EXPECT_NE(out.find("the calibrations have 5 and 2 cameras"), std::string::npos) << out;
 }

@@ -156,7 +156,9 @@ TEST(WorkerPool, WritesAreVisibleAcrossSubmitWaitAndBatches) {
   struct Step final : PoolJob {
     std::vector<int64_t>* value;
     int64_t add = 0;
-    void run(int task, int) override { (*value)[static_cast<std::size_t>(task)] = 3 * (*value)[static_cast<std::size_t>(task)] + add; }
+    void run(int task, int) override {
+      (*value)[static_cast<std::size_t>(task)] = 3 * (*value)[static_cast<std::size_t>(task)] + add;
+    }
   } job;
   job.value = &value;
   std::vector<int64_t> expected = value;

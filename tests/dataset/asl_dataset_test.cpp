@@ -24,7 +24,8 @@ std::string writeDataset(const test::TempDir& dir) {
   for (int i = 0; i < 5; ++i) {
     for (int c = 0; c < 3; ++c) {
       if (c == 1 && i == 2) continue;
-      w.writeImage(c, stamp(i) + c * 1000, test::FlatImage(static_cast<uint8_t>(10 * c + i)).image.view());  // 1 us jitter
+      w.writeImage(c, stamp(i) + c * 1000,
+                   test::FlatImage(static_cast<uint8_t>(10 * c + i)).image.view());  // 1 us jitter
     }
   }
   Trajectory gt;

@@ -18,7 +18,8 @@ namespace {
 constexpr int kFrames = 5;
 
 SE3 groundTruthPose(int i) {
-  return SE3(Eigen::AngleAxisd(0.1 * i, Vec3(0.2, 0.3, 1).normalized()).toRotationMatrix(), Vec3(0.5 * i, -0.2 * i, 0.05));
+  return SE3(Eigen::AngleAxisd(0.1 * i, Vec3(0.2, 0.3, 1).normalized()).toRotationMatrix(),
+             Vec3(0.5 * i, -0.2 * i, 0.05));
 }
 
 // An ASL dataset of `rig` with kFrames rig frames at 10 Hz (camera c's image of frame i has value 10 i + c) and
@@ -71,7 +72,8 @@ void expectSameDataset(const Dataset& a, const Dataset& b, double tol) {
     for (int c = 0; c < a.rig().size(); ++c) {
       ASSERT_EQ(a.frames()[i].image_paths[c].empty(), b.frames()[i].image_paths[c].empty()) << "frame " << i;
       if (a.frames()[i].image_paths[c].empty()) continue;
-      EXPECT_EQ(test::readFile(a.frames()[i].image_paths[c]), test::readFile(b.frames()[i].image_paths[c])) << "frame " << i;
+      EXPECT_EQ(test::readFile(a.frames()[i].image_paths[c]), test::readFile(b.frames()[i].image_paths[c]))
+          << "frame " << i;
     }
   }
   ASSERT_TRUE(a.groundTruth() && b.groundTruth());
@@ -156,7 +158,8 @@ TEST(DatasetExport, KittiLeavesOutRigFramesWithAMissingImageAndSaysSo) {
 TEST(DatasetExport, KittiRefusesDistortedOrTurnedCamerasBeforeWritingAnything) {
   test::TempDir dir("export_kitti_bad");
   Rig distorted = test::smallRig(2);
-  distorted.cameras[1].model = CameraModel(test::kWidth, test::kHeight, 20, 20, 7.5, 5.5, Distortion::RadTan, {-0.2, 0.05, 0, 0});
+  distorted.cameras[1].model =
+      CameraModel(test::kWidth, test::kHeight, 20, 20, 7.5, 5.5, Distortion::RadTan, {-0.2, 0.05, 0, 0});
   const Dataset a = Dataset::open(writeAsl(dir, distorted));
   const std::string distorted_error = exportError(a, DatasetLayoutKind::Kitti, dir.file("kitti"));
   EXPECT_NE(distorted_error.find("cam1: distortion radtan"), std::string::npos) << distorted_error;
@@ -194,7 +197,8 @@ void expectSamePixelsInPgm(const Dataset& a, const Dataset& b) {
       EXPECT_EQ(fs::path(b.frames()[i].image_paths[c]).extension(), ".pgm");
       EXPECT_EQ(test::readFile(b.frames()[i].image_paths[c]).substr(0, 2), "P5");
       ASSERT_EQ(ia[c].view().width, ib[c].view().width);
-      EXPECT_TRUE(std::equal(ia[c].data(), ia[c].data() + ia[c].width() * ia[c].height(), ib[c].data())) << "frame " << i;
+      EXPECT_TRUE(std::equal(ia[c].data(), ia[c].data() + ia[c].width() * ia[c].height(), ib[c].data()))
+          << "frame " << i;
     }
   }
 }

@@ -15,8 +15,8 @@ namespace {
 SE3 T_S_cam0() {
   Mat4 M;
   M << 0.0148655429818, -0.999880929698, 0.00414029679422, -0.0216401454975,  //
-      0.999557249008, 0.0149672133247, 0.025715529948, -0.064676986768,        //
-      -0.0257744366974, 0.00375618835797, 0.999660727178, 0.00981073058949,    //
+      0.999557249008, 0.0149672133247, 0.025715529948, -0.064676986768,       //
+      -0.0257744366974, 0.00375618835797, 0.999660727178, 0.00981073058949,   //
       0.0, 0.0, 0.0, 1.0;
   SE3 T = SE3::fromMatrix(M);
   T.normalize();
@@ -46,7 +46,8 @@ std::string writeEuroc(const test::TempDir& dir) {
     test::writeFile((cam / "data.csv").string(), csv);
   }
   std::string gt =
-      "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m s^-1], "
+      "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], q_RS_z [], v_RS_R_x [m "
+      "s^-1], "
       "v_RS_R_y [m s^-1], v_RS_R_z [m s^-1], b_w_RS_S_x [rad s^-1], b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], "
       "b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], b_a_RS_S_z [m s^-2]\n";
   for (int i = 0; i < 3; ++i) {
@@ -54,7 +55,8 @@ std::string writeEuroc(const test::TempDir& dir) {
     const Eigen::Quaterniond q = T.quaternion();
     char row[512];
     std::snprintf(row, sizeof(row), "%lld,%.12f,%.12f,%.12f,%.15f,%.15f,%.15f,%.15f,0.1,0,0,0,0,0,0,0,0\n",
-                  static_cast<long long>(kT0 + i * kPeriod + 5000), T.t.x(), T.t.y(), T.t.z(), q.w(), q.x(), q.y(), q.z());
+                  static_cast<long long>(kT0 + i * kPeriod + 5000), T.t.x(), T.t.y(), T.t.z(), q.w(), q.x(), q.y(),
+                  q.z());
     gt += row;
   }
   test::writeFile((mav0 / "state_groundtruth_estimate0" / "data.csv").string(), gt);
@@ -105,7 +107,8 @@ TEST(EurocDataset, MalformedGroundTruthNamesFileAndLine) {
     Dataset::open(root);
     FAIL() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(gt + ": line 3: p_RS_R_z is not a number: 'three'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(gt + ": line 3: p_RS_R_z is not a number: 'three'"), std::string::npos)
+        << e.what();
   }
   test::writeFile(gt, "1403636579763555584,1,2,3\n");
   EXPECT_THROW(Dataset::open(root), InputError);

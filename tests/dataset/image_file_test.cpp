@@ -38,7 +38,8 @@ std::string pgmError(const test::TempDir& dir, const std::string& bytes) {
   try {
     readPgmFile(path, image);
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << "the message does not name the file: " << e.what();
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos)
+        << "the message does not name the file: " << e.what();
     return e.what();
   }
   ADD_FAILURE() << "accepted: " << bytes.substr(0, 20);
@@ -62,7 +63,8 @@ TEST(PgmFile, WrittenImageReadsBackIdentical) {
 
 TEST(PgmFile, HeaderCommentsAndAnyWhitespaceAreRead) {
   test::TempDir dir("pgm_comments");
-  const std::string path = test::writeFile(dir.file("c.pgm"), std::string("P5 # GIMP\n3\t# width\n 2\r\n255\n") + "abcdef");
+  const std::string path =
+      test::writeFile(dir.file("c.pgm"), std::string("P5 # GIMP\n3\t# width\n 2\r\n255\n") + "abcdef");
   Image image;
   readPgmFile(path, image);
   ASSERT_EQ(image.width(), 3);
@@ -120,7 +122,8 @@ TEST(PgmFile, AMissingFileIsNamed) {
     readGreyImageFile("/nonexistent/mcslam/0.pgm", image);
     FAIL() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/mcslam/0.pgm: cannot open image"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/mcslam/0.pgm: cannot open image"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -128,7 +131,8 @@ TEST(ImageCodecModule, PngReadsBackIdenticalThroughTheModuleLoadedOnFirstUse) {
   test::TempDir dir("codec_png");
   const Image written = randomImage(41, 29, 3);
   const std::string path = dir.file("a.png");
-  ASSERT_TRUE(cv::imwrite(path, cv::Mat(written.height(), written.width(), CV_8UC1, const_cast<uint8_t*>(written.data()))));
+  ASSERT_TRUE(
+      cv::imwrite(path, cv::Mat(written.height(), written.width(), CV_8UC1, const_cast<uint8_t*>(written.data()))));
   Image read(5, 5);  // smaller: the module asks for the size it needs
   readGreyImageFile(path, read);
   expectSamePixels(written, read);
@@ -154,9 +158,11 @@ TEST(ImageCodecModule, AnUndecodableFileIsNamed) {
 TEST(ImageCodecModule, WithoutAModuleTheErrorNamesEveryPathTriedAndWhy) {
   test::TempDir dir("codec_missing");
   const std::string not_a_library = test::writeFile(dir.file("mcslam_image_codec.so"), "text");
-  const detail::ImageCodecModule module = detail::loadImageCodecModule({"/nonexistent/mcslam_image_codec.so", not_a_library});
+  const detail::ImageCodecModule module =
+      detail::loadImageCodecModule({"/nonexistent/mcslam_image_codec.so", not_a_library});
   EXPECT_EQ(module.read, nullptr);
-  EXPECT_NE(module.failure.find("/nonexistent/mcslam_image_codec.so (no such file)"), std::string::npos) << module.failure;
+  EXPECT_NE(module.failure.find("/nonexistent/mcslam_image_codec.so (no such file)"), std::string::npos)
+      << module.failure;
   EXPECT_NE(module.failure.find(not_a_library + " ("), std::string::npos) << module.failure;
   EXPECT_NE(module.failure.find("--images pgm"), std::string::npos) << module.failure;
 }

@@ -125,7 +125,8 @@ TEST(KittiDataset, MalformedCalibrationNamesFileLineAndMatrix) {
     Dataset::open(seq);
     FAIL() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(seq + "/calib.txt: line 2: P1 must have 12 numbers"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(seq + "/calib.txt: line 2: P1 must have 12 numbers"), std::string::npos)
+        << e.what();
   }
   test::writeFile(seq + "/calib.txt", "P0: 700 0 600 0 0 700 180 0 0 0 1 0\n");
   try {

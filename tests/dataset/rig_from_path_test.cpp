@@ -29,6 +29,7 @@ TEST(LoadRigFromPath, MissingPathNamesIt) {
     loadRigFromPath("/nonexistent/rig.yaml");
     FAIL() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/rig.yaml: no such file or folder"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/rig.yaml: no such file or folder"), std::string::npos)
+        << e.what();
   }
 }

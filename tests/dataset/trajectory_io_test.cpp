@@ -14,7 +14,8 @@ void expectError(const std::function<void()>& f, std::initializer_list<std::stri
     FAIL() << "no error";
   } catch (const InputError& e) {
     const std::string msg = e.what();
-    for (const auto& part : fragments) EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
+    for (const auto& part : fragments)
+      EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
   }
 }
 
@@ -36,7 +37,7 @@ TEST(TumTrajectory, ParsesStampsExactlyToTheNanosecond) {
       "1311868164.363181 0 0 0 0 0 0 1\n"
       "1403636579.763555584 1 2 3 0 0 0 1\n"
       "0.000000001 0 0 0 0 0 0 1\n"
-      "5.0000000005 0 0 0 0 0 0 1\n"   // a tenth decimal rounds
+      "5.0000000005 0 0 0 0 0 0 1\n"  // a tenth decimal rounds
       "1e2 0 0 0 0 0 0 1\n",
       "mem");
   ASSERT_EQ(t.size(), 5u);
@@ -82,7 +83,8 @@ TEST(KittiTrajectory, WriteReadRoundTripWithTimes) {
   const Trajectory in = sample();
   writeKittiTrajectory(dir.file("poses.txt"), in);
   std::string times;
-  for (const StampedPose& p : in) times += std::to_string(p.t / 1000000000) + "." + std::to_string(p.t % 1000000000 + 1000000000).substr(1) + "\n";
+  for (const StampedPose& p : in)
+    times += std::to_string(p.t / 1000000000) + "." + std::to_string(p.t % 1000000000 + 1000000000).substr(1) + "\n";
   test::writeFile(dir.file("times.txt"), times);
   const Trajectory out = readKittiTrajectory(dir.file("poses.txt"), dir.file("times.txt"));
   ASSERT_EQ(out.size(), in.size());

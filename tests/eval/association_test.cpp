@@ -26,7 +26,9 @@ TimeAssociation bruteForce(const Trajectory& ref, const Trajectory& est, double 
   for (std::size_t i = 0; i < s.size(); ++i) {
     std::size_t best = 0;
     for (std::size_t j = 1; j < l.size(); ++j) {
-      if (std::abs(stampSeconds(l[j].t) - stampSeconds(s[i].t)) < std::abs(stampSeconds(l[best].t) - stampSeconds(s[i].t))) best = j;
+      if (std::abs(stampSeconds(l[j].t) - stampSeconds(s[i].t)) <
+          std::abs(stampSeconds(l[best].t) - stampSeconds(s[i].t)))
+        best = j;
     }
     if (std::abs(stampSeconds(l[best].t) - stampSeconds(s[i].t)) <= max_diff) {
       out.ref.push_back(est_longer ? i : best);

@@ -10,8 +10,8 @@ TEST(ErrorStats, EvenCountUsesNumpyConventions) {
   const ErrorStats s = computeErrorStats({4.0, 1.0, 3.0, 2.0});
   EXPECT_EQ(s.count, 4u);
   EXPECT_DOUBLE_EQ(s.mean, 2.5);
-  EXPECT_DOUBLE_EQ(s.median, 2.5);            // mean of the two middle values
-  EXPECT_DOUBLE_EQ(s.std, std::sqrt(1.25));   // population std (numpy's default), not sqrt(5/3)
+  EXPECT_DOUBLE_EQ(s.median, 2.5);           // mean of the two middle values
+  EXPECT_DOUBLE_EQ(s.std, std::sqrt(1.25));  // population std (numpy's default), not sqrt(5/3)
   EXPECT_DOUBLE_EQ(s.rmse, std::sqrt(7.5));
   EXPECT_DOUBLE_EQ(s.sse, 30.0);
   EXPECT_DOUBLE_EQ(s.min, 1.0);

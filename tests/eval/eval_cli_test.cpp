@@ -35,9 +35,9 @@ TEST(EvalCli, ApeTextMatchesEvosFr2DeskFigures) {
 TEST(EvalCli, ApeJsonHasEveryFigureAndSim3AddsTheScale) {
   std::string out;
   ASSERT_EQ(test::runCommand(tool() + " ape " + gt() + " " + est() + " --align sim3 --json", &out), 0) << out;
-  for (const char* key : {"\"metric\": \"ape\"", "\"rmse\":", "\"mean\":", "\"median\":", "\"std\":", "\"min\":",
-                          "\"max\":", "\"pairs\": 2174", "\"path_length\":", "\"rmse_percent\":", "\"scale\":",
-                          "\"align\": \"sim3\""}) {
+  for (const char* key :
+       {"\"metric\": \"ape\"", "\"rmse\":", "\"mean\":", "\"median\":", "\"std\":", "\"min\":", "\"max\":",
+        "\"pairs\": 2174", "\"path_length\":", "\"rmse_percent\":", "\"scale\":", "\"align\": \"sim3\""}) {
     EXPECT_TRUE(contains(out, key)) << key << " missing in\n" << out;
   }
   EXPECT_EQ(out.front(), '{');
@@ -49,8 +49,8 @@ TEST(EvalCli, RpeTextAndJsonReportTranslationAndRotation) {
   EXPECT_TRUE(contains(out, "RPE for delta = 1 m")) << out;
   EXPECT_TRUE(contains(out, "translation (m)  rotation (deg)")) << out;
   ASSERT_EQ(test::runCommand(tool() + " rpe " + gt() + " " + est() + " --delta 10 --json", &out), 0) << out;
-  for (const char* key : {"\"metric\": \"rpe\"", "\"delta\": 10", "\"delta_unit\": \"f\"", "\"rmse\":",
-                          "\"rotation_deg\":", "\"path_length\":", "\"rmse_percent\":"}) {
+  for (const char* key : {"\"metric\": \"rpe\"", "\"delta\": 10", "\"delta_unit\": \"f\"",
+                          "\"rmse\":", "\"rotation_deg\":", "\"path_length\":", "\"rmse_percent\":"}) {
     EXPECT_TRUE(contains(out, key)) << key << " missing in\n" << out;
   }
 }
@@ -75,7 +75,8 @@ TEST(EvalCli, MissingFileExitsWith2AndNamesIt) {
 
 TEST(EvalCli, MalformedLineExitsWith2AndNamesFileAndLine) {
   test::TempDir dir("eval-cli");
-  const std::string bad = test::writeFile(dir.file("bad.txt"), "# t x y z qx qy qz qw\n1.0 0 0 0 0 0 0 1\n2.0 0 0 zero 0 0 0 1\n");
+  const std::string bad =
+      test::writeFile(dir.file("bad.txt"), "# t x y z qx qy qz qw\n1.0 0 0 0 0 0 0 1\n2.0 0 0 zero 0 0 0 1\n");
   std::string out;
   EXPECT_EQ(test::runCommand(tool() + " ape " + gt() + " " + bad, &out), 2);
   EXPECT_TRUE(contains(out, bad + ": line 3")) << out;
@@ -131,7 +132,9 @@ TEST(EvalCli, ReferenceCanBeADatasetFolderWithGroundTruth) {
   }
   writeTumTrajectory(dir.file("est.txt"), est);
   std::string out;
-  ASSERT_EQ(test::runCommand(tool() + " ape " + dir.file("asl") + " " + dir.file("est.txt") + " --align none --json", &out), 0)
+  ASSERT_EQ(
+      test::runCommand(tool() + " ape " + dir.file("asl") + " " + dir.file("est.txt") + " --align none --json", &out),
+      0)
       << out;
   EXPECT_TRUE(contains(out, "\"pairs\": 10")) << out;
   EXPECT_TRUE(contains(out, "\"rmse\": 0.25")) << out;

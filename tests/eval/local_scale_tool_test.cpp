@@ -62,5 +62,6 @@ TEST(LocalScaleTool, FromCountsOnlyTheSpansAfterAPose) {
   EXPECT_NE(out.find("within 5%: 0.0% of the spans"), std::string::npos) << out;
   out = localScale(files + " --from 55", &code);
   EXPECT_NE(code, 0);
-  EXPECT_NE(out.find("--from 55: needs a pose more than 10 before the last of the 60 matched"), std::string::npos) << out;
+  EXPECT_NE(out.find("--from 55: needs a pose more than 10 before the last of the 60 matched"), std::string::npos)
+      << out;
 }

@@ -69,7 +69,8 @@ TEST(OrbFast, ScoresMatchTheDefinitionOnEveryKernel) {
   int corners_seen = 0;
   for (int threshold : {7, 20, 40}) {
     for (int y = 3; y < 200; ++y) {
-      for (auto backend : {orb_detail::FastBackend::kScalar, orb_detail::FastBackend::kNative, orb_detail::FastBackend::kWide}) {
+      for (auto backend :
+           {orb_detail::FastBackend::kScalar, orb_detail::FastBackend::kNative, orb_detail::FastBackend::kWide}) {
         // An odd segment end exercises the partial last group.
         const int x0 = 3, x1 = img.width() - 3 - (y % 7);
         const int n = orb_detail::fastScoreRow(img.data(), img.width(), y, x0, x1, threshold, row.data(), backend);
@@ -181,9 +182,20 @@ TEST(OrbExtractor, FillsTheBudgetInsideTheImageAndSpreadsIt) {
   const FeatureSet g = extractWith(strongest, frame640().view());
   int strongest_blocks[6][8] = {};
   for (int i = 0; i < g.count; ++i)
-    ++strongest_blocks[std::min(5, static_cast<int>(g.keypoints[i].y / 80))][std::min(7, static_cast<int>(g.keypoints[i].x / 80))];
-  auto occupied = [](const int (&b)[6][8]) { int n = 0; for (auto& r : b) for (int v : r) n += v > 0; return n; };
-  auto fullest = [](const int (&b)[6][8]) { int n = 0; for (auto& r : b) for (int v : r) n = std::max(n, v); return n; };
+    ++strongest_blocks[std::min(5, static_cast<int>(g.keypoints[i].y / 80))]
+                      [std::min(7, static_cast<int>(g.keypoints[i].x / 80))];
+  auto occupied = [](const int(&b)[6][8]) {
+    int n = 0;
+    for (auto& r : b)
+      for (int v : r) n += v > 0;
+    return n;
+  };
+  auto fullest = [](const int(&b)[6][8]) {
+    int n = 0;
+    for (auto& r : b)
+      for (int v : r) n = std::max(n, v);
+    return n;
+  };
   EXPECT_GE(occupied(blocks), 44);
   EXPECT_GE(occupied(blocks), occupied(strongest_blocks));
   EXPECT_LT(fullest(blocks), fullest(strongest_blocks));

@@ -66,8 +66,7 @@ inline FeatureSet toFeatureSet(const std::vector<cv::KeyPoint>& keypoints, const
 
 // Matches whose keypoints agree with the true mapping from image a to image b within `tolerance` px.
 inline int countCorrect(const FeatureSet& a, const FeatureSet& b, const std::vector<Match>& matches,
-                        const std::function<bool(double, double, double&, double&)>& a_to_b,
-                        double tolerance = 3.0) {
+                        const std::function<bool(double, double, double&, double&)>& a_to_b, double tolerance = 3.0) {
   int correct = 0;
   for (const Match& m : matches) {
     double x, y;

@@ -24,7 +24,8 @@ struct Counts {
   int features = 0, matches = 0, correct = 0;
 };
 
-Counts scoreOurs(const Image& a, const Image& b, int features, const std::function<bool(double, double, double&, double&)>& map) {
+Counts scoreOurs(const Image& a, const Image& b, int features,
+                 const std::function<bool(double, double, double&, double&)>& map) {
   OrbOptions options;
   options.max_features = features;
   OrbExtractor extractor(options, a.width(), a.height());
@@ -35,7 +36,8 @@ Counts scoreOurs(const Image& a, const Image& b, int features, const std::functi
   return {std::min(fa.count, fb.count), static_cast<int>(matches.size()), countCorrect(fa, fb, matches, map)};
 }
 
-Counts scoreOpenCv(const Image& a, const Image& b, int features, const std::function<bool(double, double, double&, double&)>& map) {
+Counts scoreOpenCv(const Image& a, const Image& b, int features,
+                   const std::function<bool(double, double, double&, double&)>& map) {
   cv::setNumThreads(1);
   auto orb = cv::ORB::create(features);
   auto run = [&](const Image& image) {

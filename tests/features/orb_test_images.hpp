@@ -44,7 +44,8 @@ class ProceduralScene {
   double operator()(double x, double y) const {
     // 1/f-like multi-scale texture down to a 2-unit period, sharp-edged shapes and blobs on top.
     double v = 0, amplitude = 50.0, period = 128.0;
-    for (int o = 0; o < kOctaves; ++o, amplitude *= 0.8, period *= 0.5) v += amplitude * noise(o, x / period, y / period);
+    for (int o = 0; o < kOctaves; ++o, amplitude *= 0.8, period *= 0.5)
+      v += amplitude * noise(o, x / period, y / period);
     if (x >= 0 && y >= 0 && x < extent_ && y < extent_)
       for (int i : buckets_[static_cast<size_t>(bucket(y) * kBuckets + bucket(x))]) {
         const Shape& s = shapes_[static_cast<size_t>(i)];
@@ -76,9 +77,7 @@ class ProceduralScene {
  private:
   static constexpr int kOctaves = 7, kLattice = 64, kShapes = 700, kBuckets = 32;
 
-  int bucket(double v) const {
-    return std::clamp(static_cast<int>(v / extent_ * kBuckets), 0, kBuckets - 1);
-  }
+  int bucket(double v) const { return std::clamp(static_cast<int>(v / extent_ * kBuckets), 0, kBuckets - 1); }
 
   struct Rng {
     uint64_t state;
@@ -108,7 +107,7 @@ class ProceduralScene {
       const double r2 = dx * dx + dy * dy, reach = radius * 1.6;
       if (r2 > reach * reach) return 0;
       if (soft) return std::exp(-r2 / (0.5 * radius * radius));  // a blob
-      double inside;  // signed distance to the edge, positive inside
+      double inside;                                             // signed distance to the edge, positive inside
       if (sides >= 6) {
         inside = radius - std::sqrt(r2);
       } else {

@@ -120,7 +120,7 @@ TEST(FeatureWorkers, RigFramesAllocateNothingOnAnyThread) {
   std::vector<FeatureSet> out = makeSets();
   const bool present[kCameras] = {true, true, false, true, true};
   workers.extract(rig().views.data(), present, out.data());  // warm-up
-  const uint64_t before = alloc::totalCount();  // all threads of the process
+  const uint64_t before = alloc::totalCount();               // all threads of the process
   for (int frame = 0; frame < 5; ++frame) workers.extract(rig().views.data(), present, out.data());
   EXPECT_EQ(alloc::totalCount() - before, 0u);
   EXPECT_GT(out[4].count, 0);

@@ -104,11 +104,12 @@ TEST(EpipolarAlignment, RejectsPatchesOfDifferentTexture) {
   for (unsigned seed = 100; seed < 110; ++seed) {
     const Image other = render(Texture(seed), Mat2::Identity(), Vec2::Zero(), 1.0, 0.0);
     for (const Vec2& uv : {Vec2(60, 50), Vec2(100, 70), Vec2(150, 120)}) {
-      const EpipolarAlignment a = alignAlongEpipolar(ref.view(), uv, other.view(), uv, Vec2(1, 0), Mat2::Identity(),
-                                                     1.0, 1.0, {});
+      const EpipolarAlignment a =
+          alignAlongEpipolar(ref.view(), uv, other.view(), uv, Vec2(1, 0), Mat2::Identity(), 1.0, 1.0, {});
       ++trials;
       rejected += a.status == AlignmentStatus::Disagrees ? 1 : 0;
-      if (a.status != AlignmentStatus::Disagrees) std::printf("seed %u zncc %.3f shift %.3f status %d\n", seed, a.zncc, a.shift, int(a.status));
+      if (a.status != AlignmentStatus::Disagrees)
+        std::printf("seed %u zncc %.3f shift %.3f status %d\n", seed, a.zncc, a.shift, int(a.status));
     }
   }
   EXPECT_EQ(rejected, trials);
@@ -120,11 +121,11 @@ TEST(EpipolarAlignment, NotRefinableWithoutTextureAlongTheDirectionOrOutsideTheI
   for (int y = 0; y < 100; ++y) {
     for (int x = 0; x < 100; ++x) stripes.row(y)[x] = static_cast<uint8_t>(128 + 60 * std::sin(y * 0.7));
   }
-  const EpipolarAlignment flat =
-      alignAlongEpipolar(stripes.view(), Vec2(50, 50), stripes.view(), Vec2(50, 50), Vec2(1, 0), Mat2::Identity(), 1.0, 1.0, {});
+  const EpipolarAlignment flat = alignAlongEpipolar(stripes.view(), Vec2(50, 50), stripes.view(), Vec2(50, 50),
+                                                    Vec2(1, 0), Mat2::Identity(), 1.0, 1.0, {});
   EXPECT_NE(flat.status, AlignmentStatus::Ok);
-  const EpipolarAlignment outside =
-      alignAlongEpipolar(stripes.view(), Vec2(2, 50), stripes.view(), Vec2(50, 50), Vec2(1, 0), Mat2::Identity(), 1.0, 1.0, {});
+  const EpipolarAlignment outside = alignAlongEpipolar(stripes.view(), Vec2(2, 50), stripes.view(), Vec2(50, 50),
+                                                       Vec2(1, 0), Mat2::Identity(), 1.0, 1.0, {});
   EXPECT_EQ(outside.status, AlignmentStatus::NotRefinable);
 }
 

@@ -40,7 +40,11 @@ SyntheticFrame makeFrame(const Rig& rig, int points, int distractors, double noi
     point_octave[p] = octave(rng);
   }
   for (int c = 0; c < rig.size(); ++c) {
-    struct Item { Keypoint kp; Descriptor d; int truth; };
+    struct Item {
+      Keypoint kp;
+      Descriptor d;
+      int truth;
+    };
     std::vector<Item> items;
     for (std::size_t p = 0; p < s.scene.size(); ++p) {
       if (!s.scene[p].visible[c]) continue;
@@ -254,7 +258,8 @@ TEST(PairMatcher, MutualMatchesOfTrueCornersInsideTheEpipolarGateWhateverThePair
   std::vector<std::vector<int>> used(rig.size(), std::vector<int>(kCapacity, -1));  // pair that matched a keypoint
   for (const PairMatch& m : matches) {
     const auto& pairs = overlap.overlappingPairs();
-    const int pair = static_cast<int>(std::find(pairs.begin(), pairs.end(), std::make_pair<int, int>(m.cam_a, m.cam_b)) - pairs.begin());
+    const int pair = static_cast<int>(
+        std::find(pairs.begin(), pairs.end(), std::make_pair<int, int>(m.cam_a, m.cam_b)) - pairs.begin());
     ASSERT_LT(pair, static_cast<int>(pairs.size())) << "a match between cameras that do not overlap";
     EXPECT_GE(pair, previous_pair) << "matches not in pair order";
     previous_pair = pair;
@@ -269,7 +274,8 @@ TEST(PairMatcher, MutualMatchesOfTrueCornersInsideTheEpipolarGateWhateverThePair
     const Vec3 db = rig.T_b_c(m.cam_b).R * s.features.bearings[m.cam_b][m.kp_b];
     const Keypoint& kb = s.features.sets[m.cam_b].keypoints[m.kp_b];
     const double fj = 0.5 * (rig.model(m.cam_b).fx() + rig.model(m.cam_b).fy());
-    EXPECT_LE(std::abs(e.cross(da).normalized().dot(db)), opt.epipolar_px * std::pow(opt.octave_scale, kb.octave) / fj + 1e-6);
+    EXPECT_LE(std::abs(e.cross(da).normalized().dot(db)),
+              opt.epipolar_px * std::pow(opt.octave_scale, kb.octave) / fj + 1e-6);
   }
   EXPECT_GE(correct, 0.99 * static_cast<double>(matches.size())) << correct << " of " << matches.size();
 
@@ -280,7 +286,8 @@ TEST(PairMatcher, MutualMatchesOfTrueCornersInsideTheEpipolarGateWhateverThePair
   for (std::size_t k = 0; k < matches.size(); ++k) {
     EXPECT_TRUE(again[k].cam_a == matches[k].cam_a && again[k].cam_b == matches[k].cam_b &&
                 again[k].kp_a == matches[k].kp_a && again[k].kp_b == matches[k].kp_b &&
-                again[k].distance == matches[k].distance) << "match " << k;
+                again[k].distance == matches[k].distance)
+        << "match " << k;
   }
 }
 

@@ -48,8 +48,8 @@ TEST(FrontEnd, MatchingOnTheWorkersGivesTheSequentialFeatures) {
   const Rig rig = sim.rig().subset(front);
   const test::RenderedFrame rendered = test::renderFrame(sim, sim.frameCount() / 3, front);
 
-  for (const auto& [camera_absent, align] : {std::pair{false, false}, std::pair{true, false}, std::pair{false, true},
-                                            std::pair{true, true}}) {
+  for (const auto& [camera_absent, align] :
+       {std::pair{false, false}, std::pair{true, false}, std::pair{false, true}, std::pair{true, true}}) {
     RigFrameView view = rendered.view();
     view.cameras = rig.size();
     std::unique_ptr<bool[]> present(new bool[rig.size()]);

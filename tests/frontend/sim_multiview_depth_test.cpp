@@ -18,13 +18,13 @@ using namespace mcslam;
 namespace {
 
 struct DepthStats {
-  int judged = 0;       // map points with a true depth whose depth sigma is at most kJudgedAtTwoPercentSigma
+  int judged = 0;  // map points with a true depth whose depth sigma is at most kJudgedAtTwoPercentSigma
   int judged_within = 0;
-  int points = 0;       // map points with a true depth
-  int within = 0;       // within 2% of it
-  int gross = 0;        // more than 10% off: a wrong match
-  int honest = 0;       // within 3 of their own reported sigmas
-  int metric = 0;       // of them reported metric by the front-end (depth sigma <= 1%, verified by a third ray)
+  int points = 0;  // map points with a true depth
+  int within = 0;  // within 2% of it
+  int gross = 0;   // more than 10% off: a wrong match
+  int honest = 0;  // within 3 of their own reported sigmas
+  int metric = 0;  // of them reported metric by the front-end (depth sigma <= 1%, verified by a third ray)
   int metric_within = 0;
   // The judged points that miss 2%, by cause (first that applies): more than 10% off (a wrong match), at a depth
   // discontinuity of the truth, a two-view track, else.
@@ -58,8 +58,10 @@ double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, d
       }
       if (std::abs(d - estimate) < std::abs(nearest - estimate)) nearest = d;
       const double inv = inverse(dx, dy);
-      if (dx > -r && dx < r && std::abs(inverse(dx - 1, dy) - 2 * inv + inverse(dx + 1, dy)) > bound) discontinuity = true;
-      if (dy > -r && dy < r && std::abs(inverse(dx, dy - 1) - 2 * inv + inverse(dx, dy + 1)) > bound) discontinuity = true;
+      if (dx > -r && dx < r && std::abs(inverse(dx - 1, dy) - 2 * inv + inverse(dx + 1, dy)) > bound)
+        discontinuity = true;
+      if (dy > -r && dy < r && std::abs(inverse(dx, dy - 1) - 2 * inv + inverse(dx, dy + 1)) > bound)
+        discontinuity = true;
     }
   }
   if (edge != nullptr) *edge = discontinuity;
@@ -145,8 +147,8 @@ DepthStats indoorStats() {
     std::printf("map points %d: within 2%% %.3f, gross %.3f, within 3 sigma %.3f; metric %d, within 2%% %d\n",
                 sum.points, static_cast<double>(sum.within) / sum.points, static_cast<double>(sum.gross) / sum.points,
                 static_cast<double>(sum.honest) / sum.points, sum.metric, sum.metric_within);
-    std::printf("judged at 2%% (depth sigma <= %.4f): %d points, %d within 2%% (%.4f)\n", kJudgedAtTwoPercentSigma, sum.judged, sum.judged_within,
-                static_cast<double>(sum.judged_within) / sum.judged);
+    std::printf("judged at 2%% (depth sigma <= %.4f): %d points, %d within 2%% (%.4f)\n", kJudgedAtTwoPercentSigma,
+                sum.judged, sum.judged_within, static_cast<double>(sum.judged_within) / sum.judged);
     std::printf("judged misses: %d more than 10%% off, %d at a depth discontinuity, %d two-view, %d other\n",
                 sum.miss_gross, sum.miss_edge, sum.miss_two_view, sum.miss_other);
     return sum;

@@ -42,8 +42,8 @@ struct Score {
 };
 
 // Pixel of camera a carried to camera b through a's rendered depth.
-std::function<bool(double, double, double&, double&)> depthMapping(const Rig& rig, const sim::DepthImage& depth,
-                                                                   int a, int b) {
+std::function<bool(double, double, double&, double&)> depthMapping(const Rig& rig, const sim::DepthImage& depth, int a,
+                                                                   int b) {
   return [&rig, &depth, a, b](double x, double y, double& u, double& v) {
     const double z = test::depthAt(depth, x, y);
     Vec3 bearing;

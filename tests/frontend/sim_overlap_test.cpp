@@ -82,8 +82,8 @@ void checkPreset(const std::string& rig_name, const std::vector<int>& frames) {
         ++true_cells;
         missed_cells += map.candidates(i, j, c).empty() ? 1 : 0;
       }
-      std::printf("%s %d->%d: true cells %d (map %.0f%%), missed %d, samples %d listed %.4f\n", rig_name.c_str(), i,
-                  j, true_cells, 100.0 * map.overlapFraction(i, j), missed_cells, t.samples,
+      std::printf("%s %d->%d: true cells %d (map %.0f%%), missed %d, samples %d listed %.4f\n", rig_name.c_str(), i, j,
+                  true_cells, 100.0 * map.overlapFraction(i, j), missed_cells, t.samples,
                   t.samples ? static_cast<double>(t.listed) / t.samples : 1.0);
       if (true_cells == 0) {
         // No rendered overlap: the map may still list some (scenes at other depths), but only a little.

@@ -50,7 +50,7 @@ TEST(Triangulation, UncertaintyTellsFarPointsFromNearOnes) {
   const TriangulationResult rf = triangulate(far.data(), static_cast<int>(far.size()), opt);
   EXPECT_EQ(rn.status, TriangulationStatus::Ok);
   EXPECT_LT(std::abs(rn.point.z() - 1.5) / 1.5, 0.01);
-  EXPECT_NE(rf.status, TriangulationStatus::Ok);  // 40 m on 16.5 cm is not metric
+  EXPECT_NE(rf.status, TriangulationStatus::Ok);                     // 40 m on 16.5 cm is not metric
   EXPECT_GT(rf.relative_depth_sigma, rn.relative_depth_sigma * 10);  // grows with depth (x27 here)
 }
 

@@ -22,8 +22,8 @@ TEST(PoseSolversAllocation, GeneralizedP3PAllocatesNothing) {
   alloc::ThreadScope scope;
   for (size_t i = 0; i + 2 < scene.observations.size(); i += 3) {
     const auto& o = scene.observations;
-    total += solveGeneralizedP3P({o[i].ray, o[i + 1].ray, o[i + 2].ray}, {o[i].point_w, o[i + 1].point_w, o[i + 2].point_w},
-                                 solutions);
+    total += solveGeneralizedP3P({o[i].ray, o[i + 1].ray, o[i + 2].ray},
+                                 {o[i].point_w, o[i + 1].point_w, o[i + 2].point_w}, solutions);
   }
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_GE(total, 100);  // the calls did real work

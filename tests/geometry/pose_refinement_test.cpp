@@ -42,7 +42,8 @@ TEST(PoseRefinement, ConvergesFromPerturbedStartAndRejectsOutliers) {
     PoseRefiner refiner(shape.rig, 400);
     for (int trial = 0; trial < 5; ++trial) {
       const PoseScene scene = makePoseScene(shape.rig, 300, 0.2, 1.0, 1.0, r);
-      const SE3 start = scene.T_w_b * SE3::exp((Vec6() << 0.3 * r.unitVector(), (5.0 * M_PI / 180) * r.unitVector()).finished());
+      const SE3 start =
+          scene.T_w_b * SE3::exp((Vec6() << 0.3 * r.unitVector(), (5.0 * M_PI / 180) * r.unitVector()).finished());
       const PoseRefinementResult res = refiner.refine(scene.observations, start);
       ASSERT_TRUE(res.success) << shape.name;
       EXPECT_LT(rotationErrorDeg(res.T_w_b, scene.T_w_b), 0.1) << shape.name;

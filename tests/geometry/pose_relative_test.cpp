@@ -46,7 +46,9 @@ TwoFrames makeTwoFrames(const Rig& rig, const SE3& T_1_2, int n, double outlier_
       // Another point's bearing in frame 2, far from the right one.
       const Vec3 Y = pointSeenBy(rig, m.camera2, T_1_2, r, 2.0, 12.0);
       Vec3 wrong;
-      if (!noisyBearing(rig, m.camera2, T_1_2, Y, 0.0, r, wrong) || std::acos(std::min(1.0, wrong.dot(m.bearing2))) < 0.05) continue;
+      if (!noisyBearing(rig, m.camera2, T_1_2, Y, 0.0, r, wrong) ||
+          std::acos(std::min(1.0, wrong.dot(m.bearing2))) < 0.05)
+        continue;
       m.bearing2 = wrong;
     }
     f.matches.push_back(m);
@@ -70,7 +72,9 @@ Rig wideNonOverlappingRig() {
   return rig;
 }
 
-SE3 motion(double yaw_deg, const Vec3& t) { return SE3(so3Exp(Vec3(0.1, 1.0, 0.05).normalized() * yaw_deg * M_PI / 180), t); }
+SE3 motion(double yaw_deg, const Vec3& t) {
+  return SE3(so3Exp(Vec3(0.1, 1.0, 0.05).normalized() * yaw_deg * M_PI / 180), t);
+}
 
 int maskErrors(const TwoFrames& f, const std::vector<uint8_t>& mask) {
   int wrong = 0;
@@ -102,7 +106,8 @@ TEST(RelativePose, SampsonJacobianMatchesNumeric) {
         Tp.R = T.R * so3Exp(Vec3::Unit(k - 3) * h);
         Tm.R = T.R * so3Exp(-Vec3::Unit(k - 3) * h);
       }
-      const double numeric = (relative_pose_detail::sampsonError(p, Tp) - relative_pose_detail::sampsonError(p, Tm)) / (2 * h);
+      const double numeric =
+          (relative_pose_detail::sampsonError(p, Tp) - relative_pose_detail::sampsonError(p, Tm)) / (2 * h);
       EXPECT_NEAR(numeric, J(k), 1e-5 * std::max(1.0, std::abs(numeric))) << k;
     }
   }
@@ -124,9 +129,11 @@ TEST(RelativePose, GeneralizedRecoversMetricMotionOfNonOverlappingRig) {
     ASSERT_EQ(res.status, RelativePoseStatus::Ok) << relativePoseStatusName(res.status);
     EXPECT_TRUE(res.metric);
     const double scale_error = res.T_1_2.t.norm() / f.T_1_2.t.norm() - 1.0;
-    std::printf("non-overlapping scene %d: |t| %.4f m (true %.4f), scale error %+.2f%%, sigma %.2f%%, rotation error %.4f deg\n",
-                seed, res.T_1_2.t.norm(), f.T_1_2.t.norm(), 100 * scale_error, 100 * res.relative_scale_sigma,
-                rotationErrorDeg(res.T_1_2, f.T_1_2));
+    std::printf(
+        "non-overlapping scene %d: |t| %.4f m (true %.4f), scale error %+.2f%%, sigma %.2f%%, rotation error %.4f "
+        "deg\n",
+        seed, res.T_1_2.t.norm(), f.T_1_2.t.norm(), 100 * scale_error, 100 * res.relative_scale_sigma,
+        rotationErrorDeg(res.T_1_2, f.T_1_2));
     EXPECT_LT(std::abs(scale_error), 0.05) << seed;
     EXPECT_LT(std::abs(scale_error), 3.0 * res.relative_scale_sigma) << seed;
     EXPECT_LT((res.T_1_2.t - f.T_1_2.t).norm() / f.T_1_2.t.norm(), 0.05) << seed;

@@ -19,9 +19,10 @@ inline CameraModel fisheyeEquidistant() {
 
 inline RigCamera rigCamera(const std::string& name, const CameraModel& model, const Vec3& yaw_pitch_roll,
                            const Vec3& position) {
-  const Mat3 R = (Eigen::AngleAxisd(yaw_pitch_roll[0], Vec3::UnitY()) * Eigen::AngleAxisd(yaw_pitch_roll[1], Vec3::UnitX()) *
-                  Eigen::AngleAxisd(yaw_pitch_roll[2], Vec3::UnitZ()))
-                     .toRotationMatrix();
+  const Mat3 R =
+      (Eigen::AngleAxisd(yaw_pitch_roll[0], Vec3::UnitY()) * Eigen::AngleAxisd(yaw_pitch_roll[1], Vec3::UnitX()) *
+       Eigen::AngleAxisd(yaw_pitch_roll[2], Vec3::UnitZ()))
+          .toRotationMatrix();
   return {name, model, SE3(R, position), 0};
 }
 
@@ -51,7 +52,8 @@ inline Rig ringRig() {
   for (int i = 0; i < 6; ++i) {
     const double yaw = i * M_PI / 3;
     rig.cameras.push_back(rigCamera("cam" + std::to_string(i), i % 2 ? fisheyeEquidistant() : pinholeRadtan(),
-                                    {yaw, 0.1 * (i % 3 - 1), 0}, {0.25 * std::sin(yaw), 0.02 * i, 0.25 * std::cos(yaw)}));
+                                    {yaw, 0.1 * (i % 3 - 1), 0},
+                                    {0.25 * std::sin(yaw), 0.02 * i, 0.25 * std::cos(yaw)}));
   }
   return rig;
 }
@@ -61,7 +63,8 @@ struct NamedRig {
   Rig rig;
 };
 inline std::vector<NamedRig> allRigShapes() {
-  return {{"mono", monoRig()}, {"stereo", stereoRig()}, {"non_overlapping_3", nonOverlappingRig()}, {"ring_6", ringRig()}};
+  return {
+      {"mono", monoRig()}, {"stereo", stereoRig()}, {"non_overlapping_3", nonOverlappingRig()}, {"ring_6", ringRig()}};
 }
 
 class SceneRandom {

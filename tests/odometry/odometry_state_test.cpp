@@ -9,10 +9,10 @@
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/odometry/landmark_tracks.hpp"
 #include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/odometry.hpp"
 #include "mcslam/odometry/rig_state.hpp"
 #include "mcslam/odometry/scale_supervisor.hpp"
 #include "mcslam/odometry/window_bridge.hpp"
-#include "mcslam/odometry/odometry.hpp"
 #include "synthetic_sequence.hpp"
 
 using namespace mcslam;

@@ -21,7 +21,7 @@ struct RunResult {
   double ate = 0;
   double scale = 1;
   uint64_t allocations_after_warmup = 0;
-  int first_metric = -1;     // first tracked frame whose pose says it is metric
+  int first_metric = -1;                                    // first tracked frame whose pose says it is metric
   int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
 };
 
@@ -43,7 +43,8 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
     odo.process(f, i, pose);
     if (i >= so.warmup_frames) {
       r.allocations_after_warmup += scope.count();
-      if (scope.count() && std::getenv("MCSLAM_DEBUG_ALLOC")) std::printf("frame %d allocs %llu\n", i, (unsigned long long)scope.count());
+      if (scope.count() && std::getenv("MCSLAM_DEBUG_ALLOC"))
+        std::printf("frame %d allocs %llu\n", i, (unsigned long long)scope.count());
     }
     if (pose.valid && pose.state == TrackingState::Tracking) {
       r.estimate.push_back({pose.t, pose.T_w_b});
@@ -58,11 +59,13 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
   r.allocations_after_warmup += odo.backendThreadAllocations() - backend_thread_before;
   r.stats = odo.stats();
   r.ate = test::alignedRmse(seq.groundTruth(), r.estimate, sim3, &r.scale);
-  std::printf("cams %d: frames %llu tracking %llu lost %llu notinit %llu kf %llu inits %llu recov %llu  ATE %.4f m scale %.4f allocs %llu\n",
-              rig.size(), (unsigned long long)r.stats.frames, (unsigned long long)r.stats.tracking,
-              (unsigned long long)r.stats.lost, (unsigned long long)r.stats.not_initialized,
-              (unsigned long long)r.stats.keyframes, (unsigned long long)r.stats.initializations,
-              (unsigned long long)r.stats.recoveries, r.ate, r.scale, (unsigned long long)r.allocations_after_warmup);
+  std::printf(
+      "cams %d: frames %llu tracking %llu lost %llu notinit %llu kf %llu inits %llu recov %llu  ATE %.4f m scale %.4f "
+      "allocs %llu\n",
+      rig.size(), (unsigned long long)r.stats.frames, (unsigned long long)r.stats.tracking,
+      (unsigned long long)r.stats.lost, (unsigned long long)r.stats.not_initialized,
+      (unsigned long long)r.stats.keyframes, (unsigned long long)r.stats.initializations,
+      (unsigned long long)r.stats.recoveries, r.ate, r.scale, (unsigned long long)r.allocations_after_warmup);
   return r;
 }
 
@@ -122,9 +125,10 @@ static void expectMetricScaleOnceConverged(const test::SyntheticSequenceOptions&
   test::alignedRmse(seq.groundTruth(), before, true, &scale_before);
   const double ate_after = test::alignedRmse(seq.groundTruth(), after, false);
   test::alignedRmse(seq.groundTruth(), after, true, &scale_after);
-  std::printf("scale converged at frame %lld (combined sigma %.4f); Sim(3) scale before %.4f after %.4f, ATE after %.4f m\n",
-              static_cast<long long>(r.stats.scale_converged_frame), r.stats.combined_scale_sigma, scale_before,
-              scale_after, ate_after);
+  std::printf(
+      "scale converged at frame %lld (combined sigma %.4f); Sim(3) scale before %.4f after %.4f, ATE after %.4f m\n",
+      static_cast<long long>(r.stats.scale_converged_frame), r.stats.combined_scale_sigma, scale_before, scale_after,
+      ate_after);
   EXPECT_GT(std::abs(scale_before - 1.0), 0.05) << "the start is up to scale: its unit is arbitrary";
   ASSERT_GE(after.size(), 100u);
   EXPECT_NEAR(scale_after, 1.0, 0.05);

@@ -24,7 +24,8 @@ void buildWindow(const Rig& rig, Map& map, double turn_deg, double map_scale, do
   std::vector<SE3> poses;
   for (int k = 0; k < kKeyframes; ++k) {
     const double a = turn_deg * M_PI / 180.0 * k / (kKeyframes - 1);
-    poses.emplace_back(Eigen::AngleAxisd(a, Vec3::UnitY()).toRotationMatrix(), Vec3(0.05 * k * k / 7.0, 0, 1.0 * k / 7.0));
+    poses.emplace_back(Eigen::AngleAxisd(a, Vec3::UnitY()).toRotationMatrix(),
+                       Vec3(0.05 * k * k / 7.0, 0, 1.0 * k / 7.0));
   }
   std::vector<int> slots;
   for (int k = 0; k < kKeyframes; ++k) {
@@ -71,8 +72,8 @@ TEST(ScaleEstimator, FindsTheMetricScaleOfATurningWindow) {
     buildWindow(rig, map, 60.0, map_scale, 0.5);
     ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 14, 1.2f, 8);
     const ScaleEstimate e = est.estimate(map, 30.0);
-    std::printf("map scale %.2f: estimate %.4f (expected %.4f), sigma %.4f, %d landmarks, chi2/dof %.3f\n",
-                map_scale, e.scale, 1.0 / map_scale, e.relative_sigma, e.landmarks, e.reduced_chi2);
+    std::printf("map scale %.2f: estimate %.4f (expected %.4f), sigma %.4f, %d landmarks, chi2/dof %.3f\n", map_scale,
+                e.scale, 1.0 / map_scale, e.relative_sigma, e.landmarks, e.reduced_chi2);
     ASSERT_TRUE(e.ok);
     EXPECT_LT(e.relative_sigma, 0.05);
     EXPECT_NEAR(e.scale * map_scale, 1.0, 3.0 * e.relative_sigma);
@@ -136,11 +137,11 @@ TEST(ScaleFilter, RotationSpanCountsFromTheFirstEstimateKept) {
 // ones' keyframes and more of the turn); windows that share none are independent and their information adds.
 TEST(ScaleFilter, OverlappingWindowsCountOnceDisjointOnesAdd) {
   ScaleFilter f;
-  EXPECT_TRUE(f.add(0.10, 0.20, 0, 13, 0.0));   // before the turn: little information
-  EXPECT_TRUE(f.add(0.20, 0.03, 3, 16, 0.5));   // in it: this one supersedes the first
+  EXPECT_TRUE(f.add(0.10, 0.20, 0, 13, 0.0));  // before the turn: little information
+  EXPECT_TRUE(f.add(0.20, 0.03, 3, 16, 0.5));  // in it: this one supersedes the first
   EXPECT_NEAR(f.correction(), 0.20, 1e-12);
   EXPECT_NEAR(f.sigma(), 0.03, 1e-12);
-  EXPECT_TRUE(f.add(0.19, 0.05, 6, 19, 0.9));   // less certain, overlapping: adds nothing
+  EXPECT_TRUE(f.add(0.19, 0.05, 6, 19, 0.9));  // less certain, overlapping: adds nothing
   EXPECT_NEAR(f.sigma(), 0.03, 1e-12);
   EXPECT_TRUE(f.add(0.22, 0.03, 17, 30, 3.0));  // shares no keyframe with the pending one: both count
   EXPECT_NEAR(f.correction(), 0.21, 1e-12);
@@ -202,7 +203,7 @@ TEST(ScaleFilter, OnceConvergedARestartNeedsRejectedWindowsThatShareNoKeyframe) 
   EXPECT_FALSE(f.add(1.0, 0.02, 15, 28, 1.1));
   EXPECT_FALSE(f.add(1.0, 0.02, 16, 29, 1.2));  // the third in a row, but all share keyframes 16-27
   EXPECT_NEAR(f.correction(), 0.0, 1e-12);
-  EXPECT_TRUE(f.add(1.0, 0.02, 28, 41, 2.0));   // none shared with the first: the scale moved
+  EXPECT_TRUE(f.add(1.0, 0.02, 28, 41, 2.0));  // none shared with the first: the scale moved
   EXPECT_NEAR(f.correction(), 1.0, 1e-12);
   EXPECT_NEAR(f.sigma(), 0.02, 1e-12);
 }

@@ -183,7 +183,8 @@ double alignedRmse(const Trajectory& truth, const Trajectory& est, bool scale, d
     B.col(i) = b[i];
   }
   const Eigen::Matrix4d T = Eigen::umeyama(A, B, scale);
-  if (scale_out) *scale_out = T.topLeftCorner<3, 3>().determinant() > 0 ? std::cbrt(T.topLeftCorner<3, 3>().determinant()) : 0;
+  if (scale_out)
+    *scale_out = T.topLeftCorner<3, 3>().determinant() > 0 ? std::cbrt(T.topLeftCorner<3, 3>().determinant()) : 0;
   double sum = 0;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const Vec3 p = T.topLeftCorner<3, 3>() * a[i] + T.topRightCorner<3, 1>();

@@ -20,7 +20,7 @@ Rig nonOverlappingRig3();
 struct SyntheticSequenceOptions {
   int frames = 200;
   double rate_hz = 10.0;
-  double radius_m = 4.0;         // loop radius (a circle with a wobble); the world's wall stands around it
+  double radius_m = 4.0;  // loop radius (a circle with a wobble); the world's wall stands around it
   // Instead of the circle: a rounded rectangle of straights and quarter-turn corners, as rooms and corridors
   // make a ground robot drive (corner radius 1.2 m: 48 deg/s at 1 m/s). Sides in metres, centred on the loop.
   bool rounded_rectangle = false;

@@ -43,9 +43,9 @@ class CameraStudy : public ::testing::Test {
   static void TearDownTestSuite() { dir_.reset(); }
   static std::string runStudy(const std::string& args, int* code = nullptr) {
     std::string out;
-    const int c = test::runCommand("python3 " + study() + " --bin " + test::binPath("") + " --dataset " +
-                                       dir_->file("seq") + " " + args + " 2>&1",
-                                   &out);
+    const int c = test::runCommand(
+        "python3 " + study() + " --bin " + test::binPath("") + " --dataset " + dir_->file("seq") + " " + args + " 2>&1",
+        &out);
     if (code) *code = c;
     return out;
   }
@@ -78,9 +78,10 @@ TEST_F(CameraStudy, RepeatsSpreadTheFeatureCountAndTheMiddleRunIsThePlainRun) {
   // The run at the configured count is mcslam-run on defaults, pose for pose.
   const std::string plain = dir_->file("plain.tum");
   std::string run_out;
-  ASSERT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file("seq") + " --cameras 0,1 --quiet --out " +
-                                 plain, &run_out),
-            0)
+  ASSERT_EQ(
+      test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file("seq") + " --cameras 0,1 --quiet --out " + plain,
+                       &run_out),
+      0)
       << run_out;
   const std::string expected = readFile(plain);
   ASSERT_FALSE(expected.empty());

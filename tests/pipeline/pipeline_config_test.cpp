@@ -31,7 +31,8 @@ TEST(PipelineConfig, AbsentSectionGivesDefaults) {
 }
 
 TEST(PipelineConfig, EffectiveConfigReadsBackToTheSameValues) {
-  const PipelineConfig c = parsePipelineConfig(YAML::Load("features: {levels: 6}\ntracking: {radius_px: 22}"), "x.yaml", isec());
+  const PipelineConfig c =
+      parsePipelineConfig(YAML::Load("features: {levels: 6}\ntracking: {radius_px: 22}"), "x.yaml", isec());
   const YAML::Node back = YAML::Load(formatPipelineConfig(c));
   const PipelineConfig d = parsePipelineConfig(back["slam"], "effective", isec());
   EXPECT_EQ(d.orb.levels, 6);
@@ -40,8 +41,10 @@ TEST(PipelineConfig, EffectiveConfigReadsBackToTheSameValues) {
 }
 
 TEST(PipelineConfig, BadValuesNameFileAndKey) {
-  EXPECT_NE(errorOf("capacity: {max_featurs: 10}").find("run.yaml: slam.capacity.max_featurs: unknown key"), std::string::npos);
-  EXPECT_NE(errorOf("capacity: {max_features_per_camera: 0}").find("slam.capacity.max_features_per_camera"), std::string::npos);
+  EXPECT_NE(errorOf("capacity: {max_featurs: 10}").find("run.yaml: slam.capacity.max_featurs: unknown key"),
+            std::string::npos);
+  EXPECT_NE(errorOf("capacity: {max_features_per_camera: 0}").find("slam.capacity.max_features_per_camera"),
+            std::string::npos);
   EXPECT_NE(errorOf("tracking: {ratio: high}").find("slam.tracking.ratio"), std::string::npos);
   EXPECT_NE(errorOf("backend: {refine_extrinsics: maybe}").find("auto, on, off"), std::string::npos);
   EXPECT_NE(errorOf("features: [1, 2]").find("slam.features: must be a map"), std::string::npos);

@@ -25,14 +25,17 @@ class RunLayouts : public ::testing::Test {
     dir_ = std::make_unique<test::TempDir>("run_layouts");
     const std::string asl = dir_->file("asl");
     std::string out;
-    const int code = test::runCommand(bin("mcslam-sim") + " --rig " + test::dataPath("calib/rectified_stereo_camchain.yaml") +
-                                          " --world indoor --frames " + std::to_string(kFrames) +
-                                          " --no-depth --quiet --seed 3 --out " + asl,
-                                      &out);
+    const int code = test::runCommand(
+        bin("mcslam-sim") + " --rig " + test::dataPath("calib/rectified_stereo_camchain.yaml") +
+            " --world indoor --frames " + std::to_string(kFrames) + " --no-depth --quiet --seed 3 --out " + asl,
+        &out);
     ASSERT_EQ(code, 0) << out;
     for (const char* layout : {"euroc", "kitti"}) {
-      ASSERT_EQ(test::runCommand(bin("mcslam-dataset") + " convert " + asl + " --layout " + layout + " --out " +
-                                     dir_->file(layout), &out), 0) << out;
+      ASSERT_EQ(
+          test::runCommand(
+              bin("mcslam-dataset") + " convert " + asl + " --layout " + layout + " --out " + dir_->file(layout), &out),
+          0)
+          << out;
     }
   }
   static void TearDownTestSuite() { dir_.reset(); }
@@ -42,7 +45,9 @@ class RunLayouts : public ::testing::Test {
     const std::string traj = dir_->file(tag + ".tum");
     std::string out;
     EXPECT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file(layout) + " --quiet --out " + traj +
-                                   " --stats " + dir_->file(tag + ".json") + " " + extra, &out), 0)
+                                   " --stats " + dir_->file(tag + ".json") + " " + extra,
+                               &out),
+              0)
         << out;
     return readTumTrajectory(traj);
   }
@@ -54,7 +59,8 @@ std::unique_ptr<test::TempDir> RunLayouts::dir_;
 
 double maxPositionDifference(const Trajectory& a, const Trajectory& b) {
   double worst = 0;
-  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) worst = std::max(worst, (a[i].T_w_b.t - b[i].T_w_b.t).norm());
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+    worst = std::max(worst, (a[i].T_w_b.t - b[i].T_w_b.t).norm());
   return worst;
 }
 
@@ -87,13 +93,15 @@ TEST_F(RunLayouts, EveryLayoutGivesTheSameTrajectoryAndItMatchesItsGroundTruth) 
   EXPECT_NE(stats.find("\"state_changes\": [\n    {\n      \"frame\": 0,"), std::string::npos) << stats;
   EXPECT_NE(stats.find("\"state\": \"tracking\""), std::string::npos) << stats;
   // And each matches the ground truth its own layout carries (TUM body poses, EuRoC state csv, KITTI poses.txt).
-  for (const auto& [layout, trajectory] : {std::pair{"asl", &asl}, std::pair{"euroc", &euroc}, std::pair{"kitti", &kitti}}) {
+  for (const auto& [layout, trajectory] :
+       {std::pair{"asl", &asl}, std::pair{"euroc", &euroc}, std::pair{"kitti", &kitti}}) {
     const Dataset ds = Dataset::open(dir_->file(layout));
     ASSERT_TRUE(ds.groundTruth()) << layout;
     const ApeResult ape = computeApe(*ds.groundTruth(), *trajectory, {});
     EXPECT_EQ(ape.errors.size(), static_cast<std::size_t>(kFrames)) << layout;
     EXPECT_GT(ape.data.ref_path_length, 2.0) << layout;  // the robot really moved
-    EXPECT_LT(ape.stats.rmse, 0.02) << layout << ": ATE " << ape.stats.rmse << " m over " << ape.data.ref_path_length << " m";
+    EXPECT_LT(ape.stats.rmse, 0.02) << layout << ": ATE " << ape.stats.rmse << " m over " << ape.data.ref_path_length
+                                    << " m";
   }
 }
 
@@ -109,7 +117,8 @@ TEST_F(RunLayouts, TheRunnerSaysWhenTheTrajectoryIsNotMetric) {
   // Every frame with a pose is counted up to scale: those tracked and those interpolated before initialization.
   const std::string one_stats = test::readFile(dir_->file("unit.json"));
   EXPECT_EQ(jsonInt(one_stats, "frames_unknown_scale"),
-            jsonInt(one_stats, "tracking") + jsonInt(one_stats, "interpolated_before_initialization")) << one_stats;
+            jsonInt(one_stats, "tracking") + jsonInt(one_stats, "interpolated_before_initialization"))
+      << one_stats;
   EXPECT_GT(jsonInt(one_stats, "frames_unknown_scale"), 20) << one_stats;
   ASSERT_EQ(test::runCommand(common, &pair), 0) << pair;
   EXPECT_EQ(pair.find("up to scale"), std::string::npos) << pair;

@@ -72,9 +72,7 @@ TEST(BackPressure, ASourceMayRunTwoFramesAheadOfWhatIsDone) {
   EXPECT_TRUE(pressure.waitForRoom(1, stop));
   // Two emitted, none done: the third waits until one is done.
   std::atomic<bool> room{false};
-  std::thread source([&] {
-    room = pressure.waitForRoom(2, stop, 60000000000);
-  });
+  std::thread source([&] { room = pressure.waitForRoom(2, stop, 60000000000); });
   pressure.done();
   source.join();
   EXPECT_TRUE(room.load());

@@ -74,7 +74,8 @@ TEST_F(ConfigTest, WrongTypesNameTheKeyAndTheValue) {
 }
 
 TEST_F(ConfigTest, ZeroCapacitiesAreRefused) {
-  for (const char* key : {"max_cameras", "camera_ring_slots", "pending_rig_frames", "rig_ring_slots", "pose_ring_slots"})
+  for (const char* key :
+       {"max_cameras", "camera_ring_slots", "pending_rig_frames", "rig_ring_slots", "pose_ring_slots"})
     expectError(replay("capacities:\n  " + std::string(key) + ": 0\n"),
                 {"capacities." + std::string(key), "at least 1"});
   expectError(replay("publish:\n  shm:\n    ring_length: 0\n"), {"publish.shm.ring_length", "at least 1"});
@@ -89,8 +90,9 @@ TEST_F(ConfigTest, CameraCountMustMatchTheCalibration) {
 
 TEST_F(ConfigTest, InconsistentCombinationsAreRefused) {
   expectError(replay("trigger:\n  mode: gpio\n  gpio_chip: gpiochip0\n  gpio_line: 1\n"), {"trigger", "gpio"});
-  expectError("calibration: " + calib_ + "\nsource:\n  type: aravis\n  aravis:\n    cameras: [{id: a}, {id: b}, {id: c}]\n"
-              "trigger:\n  mode: gpio\n",
+  expectError("calibration: " + calib_ +
+                  "\nsource:\n  type: aravis\n  aravis:\n    cameras: [{id: a}, {id: b}, {id: c}]\n"
+                  "trigger:\n  mode: gpio\n",
               {"trigger.gpio_chip", "required"});
   expectError("source:\n  type: dataset\n", {"source.dataset.path", "missing"});
   expectError("source:\n  type: aravis\n  aravis:\n    cameras: [{id: a}]\n", {"calibration", "missing"});
@@ -100,20 +102,20 @@ TEST_F(ConfigTest, InconsistentCombinationsAreRefused) {
   expectError("source:\n  type: dataset\n  dataset: {path: x}\n  aravis: {}\n", {"source.aravis"});
 }
 
-TEST_F(ConfigTest, MalformedYamlIsReportedWithTheFile) {
-  expectError("source: {type: dataset\n", {"not valid YAML"});
-}
+TEST_F(ConfigTest, MalformedYamlIsReportedWithTheFile) { expectError("source: {type: dataset\n", {"not valid YAML"}); }
 
 TEST_F(ConfigTest, SimSourceGetsThePresetsCamerasAndDefaults) {
   const DaemonConfig c = parseDaemonConfig(
-      "source:\n  type: sim\n  sim:\n    rig: isec\n    cameras: [0, 1, 2, 3, 4]\n    world: corridor\n", dir_.file("sim.yaml"));
+      "source:\n  type: sim\n  sim:\n    rig: isec\n    cameras: [0, 1, 2, 3, 4]\n    world: corridor\n",
+      dir_.file("sim.yaml"));
   EXPECT_EQ(c.source_type, SourceType::Sim);
   EXPECT_EQ(c.rig.size(), 5);
   EXPECT_EQ(c.rig.model(0).width(), 720);
   EXPECT_EQ(c.sim.world, "corridor");
   EXPECT_EQ(c.sim.pace, SimPace::Fastest);
   EXPECT_EQ(c.sim.at_end, AtEnd::Loop);
-  EXPECT_TRUE(exitsAtEnd(parseDaemonConfig("source:\n  type: sim\n  sim: {rig: stereo, at_end: exit}\n", dir_.file("s.yaml"))));
+  EXPECT_TRUE(
+      exitsAtEnd(parseDaemonConfig("source:\n  type: sim\n  sim: {rig: stereo, at_end: exit}\n", dir_.file("s.yaml"))));
   const std::string effective = effectiveDaemonConfig(c);
   EXPECT_NE(effective.find("world: corridor"), std::string::npos) << effective;
   EXPECT_NE(effective.find("cameras: [0, 1, 2, 3, 4]"), std::string::npos) << effective;
@@ -134,15 +136,18 @@ TEST_F(ConfigTest, SimSourceErrorsNameTheKeyAndTheValue) {
   expectError(sim + "    pace: warp\n", {"source.sim.pace", "'warp'"});
   expectError(sim + "    frames: -3\n", {"source.sim.frames"});
   expectError("calibration: " + calib_ + "\n" + sim + "    rig: stereo\n", {"calibration", "source.sim.rig"});
-  expectError(sim + "    rig: stereo\ntrigger:\n  mode: gpio\n  gpio_chip: gpiochip0\n  gpio_line: 1\n", {"trigger", "gpio"});
+  expectError(sim + "    rig: stereo\ntrigger:\n  mode: gpio\n  gpio_chip: gpiochip0\n  gpio_line: 1\n",
+              {"trigger", "gpio"});
   expectError("source:\n  type: sim\n  dataset: {path: x}\n", {"source.dataset", "source.type is sim"});
 }
 
 // The enumerated settings are enums past the reader: every name users write maps to its value and is written back
 // by --check-config under the same name; any other value is refused naming the key, the value and the choices.
 TEST_F(ConfigTest, EnumeratedSettingsAreReadIntoEnumsAndWrittenBackByName) {
-  for (const auto& [name, rate] : {std::pair{"recorded", ReplayRate::Recorded}, std::pair{"fastest", ReplayRate::Fastest}}) {
-    for (const auto& [end_name, end] : {std::pair{"exit", AtEnd::Exit}, std::pair{"loop", AtEnd::Loop}, std::pair{"idle", AtEnd::Idle}}) {
+  for (const auto& [name, rate] :
+       {std::pair{"recorded", ReplayRate::Recorded}, std::pair{"fastest", ReplayRate::Fastest}}) {
+    for (const auto& [end_name, end] :
+         {std::pair{"exit", AtEnd::Exit}, std::pair{"loop", AtEnd::Loop}, std::pair{"idle", AtEnd::Idle}}) {
       const std::string yaml = replay(std::string("    rate: ") + name + "\n    at_end: " + end_name + "\n");
       const DaemonConfig c = parseDaemonConfig(yaml, dir_.file("ok.yaml"));
       EXPECT_EQ(c.dataset.rate, rate) << yaml;
@@ -153,27 +158,31 @@ TEST_F(ConfigTest, EnumeratedSettingsAreReadIntoEnumsAndWrittenBackByName) {
       EXPECT_NE(effective.find(std::string("at_end: ") + end_name + "\n"), std::string::npos) << effective;
     }
   }
-  for (const auto& [name, mode] : {std::pair{"free_running", TriggerMode::FreeRunning}, std::pair{"software", TriggerMode::Software}}) {
-    const DaemonConfig c = parseDaemonConfig(replay(std::string("trigger:\n  mode: ") + name + "\n"), dir_.file("ok.yaml"));
+  for (const auto& [name, mode] :
+       {std::pair{"free_running", TriggerMode::FreeRunning}, std::pair{"software", TriggerMode::Software}}) {
+    const DaemonConfig c =
+        parseDaemonConfig(replay(std::string("trigger:\n  mode: ") + name + "\n"), dir_.file("ok.yaml"));
     EXPECT_EQ(c.trigger.mode, mode);
     EXPECT_NE(effectiveDaemonConfig(c).find(std::string("mode: ") + name + "\n"), std::string::npos);
   }
-  const DaemonConfig gpio = parseDaemonConfig("calibration: " + calib_ +
-                                                  "\nsource:\n  type: aravis\n  aravis:\n    cameras: [{id: a}, {id: b}, {id: c}]\n"
-                                                  "trigger:\n  mode: gpio\n  gpio_chip: gpiochip0\n  gpio_line: 3\n",
-                                              dir_.file("ok.yaml"));
+  const DaemonConfig gpio =
+      parseDaemonConfig("calibration: " + calib_ +
+                            "\nsource:\n  type: aravis\n  aravis:\n    cameras: [{id: a}, {id: b}, {id: c}]\n"
+                            "trigger:\n  mode: gpio\n  gpio_chip: gpiochip0\n  gpio_line: 3\n",
+                        dir_.file("ok.yaml"));
   EXPECT_EQ(gpio.source_type, SourceType::Aravis);
   EXPECT_EQ(gpio.trigger.mode, TriggerMode::Gpio);
   EXPECT_NE(effectiveDaemonConfig(gpio).find("type: aravis\n"), std::string::npos);
   EXPECT_NE(effectiveDaemonConfig(gpio).find("mode: gpio\n"), std::string::npos);
   for (const auto& [name, match] : {std::pair{"trigger_count", RigAssembler::MatchBy::TriggerCount},
                                     std::pair{"timestamp", RigAssembler::MatchBy::Timestamp}}) {
-    const DaemonConfig c = parseDaemonConfig(replay(std::string("assembly:\n  match_by: ") + name + "\n"), dir_.file("ok.yaml"));
+    const DaemonConfig c =
+        parseDaemonConfig(replay(std::string("assembly:\n  match_by: ") + name + "\n"), dir_.file("ok.yaml"));
     EXPECT_EQ(c.assembly.match_by, match);
     EXPECT_NE(effectiveDaemonConfig(c).find(std::string("match_by: ") + name + "\n"), std::string::npos);
   }
-  const DaemonConfig sim = parseDaemonConfig("source:\n  type: sim\n  sim: {rig: stereo, pace: realtime, at_end: idle}\n",
-                                             dir_.file("ok.yaml"));
+  const DaemonConfig sim = parseDaemonConfig(
+      "source:\n  type: sim\n  sim: {rig: stereo, pace: realtime, at_end: idle}\n", dir_.file("ok.yaml"));
   EXPECT_EQ(sim.sim.pace, SimPace::Realtime);
   EXPECT_EQ(sim.sim.at_end, AtEnd::Idle);
   EXPECT_FALSE(exitsAtEnd(sim));
@@ -184,10 +193,12 @@ TEST_F(ConfigTest, EnumeratedSettingsAreReadIntoEnumsAndWrittenBackByName) {
 TEST_F(ConfigTest, AnUnknownEnumeratedValueIsRefusedWithTheChoices) {
   expectError(replay("    rate: slow\n"), {"source.dataset.rate", "'slow' is not one of: recorded, fastest"});
   expectError(replay("    at_end: stop\n"), {"source.dataset.at_end", "'stop' is not one of: exit, loop, idle"});
-  expectError(replay("trigger:\n  mode: laser\n"), {"trigger.mode", "'laser' is not one of: free_running, software, gpio"});
+  expectError(replay("trigger:\n  mode: laser\n"),
+              {"trigger.mode", "'laser' is not one of: free_running, software, gpio"});
   expectError(replay("assembly:\n  match_by: luck\n"),
               {"assembly.match_by", "'luck' is not one of: trigger_count, timestamp"});
-  expectError("source:\n  type: sim\n  sim:\n    pace: warp\n", {"source.sim.pace", "'warp' is not one of: fastest, realtime"});
+  expectError("source:\n  type: sim\n  sim:\n    pace: warp\n",
+              {"source.sim.pace", "'warp' is not one of: fastest, realtime"});
   expectError("source:\n  type: camera\n", {"source.type", "'camera' is not one of: dataset, aravis, sim"});
   expectError("source: {}\n", {"source.type", "missing (required): dataset, aravis or sim"});
 }

@@ -27,8 +27,8 @@ inline Rig smallRig(int cameras, int width, int height) {
 }
 
 // `frames` rig frames every `period_ns`, random (seeded) texture; returns the folder.
-inline std::string writeSmallDataset(const std::string& dir, int cameras, int frames, int width = 64,
-                                     int height = 48, Timestamp period_ns = 50000000) {
+inline std::string writeSmallDataset(const std::string& dir, int cameras, int frames, int width = 64, int height = 48,
+                                     Timestamp period_ns = 50000000) {
   AslDatasetWriter writer(dir, smallRig(cameras, width, height));
   std::mt19937 rng(7);
   Image img(width, height);

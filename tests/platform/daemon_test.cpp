@@ -17,9 +17,9 @@
 #include "daemon/daemon_config.hpp"
 #include "daemon/supervisor.hpp"
 #include "daemon_fixture.hpp"
-#include "sim_dataset_fixture.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
 #include "mcslam/pose_shm.hpp"
+#include "sim_dataset_fixture.hpp"
 #include "test_support.hpp"
 
 using namespace mcslam;
@@ -308,7 +308,8 @@ TEST_F(DaemonTest, SimSourceDeliversTheSimulatorsFramesWholeAndInOrder) {
   const int frames = 4;
   const DaemonConfig c = parseDaemonConfig(
       "source:\n  type: sim\n  sim:\n    rig: isec\n    cameras: [3, 1]\n    frames: 4\n    at_end: exit\n"
-      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " + dir_.path().string() + "\n",
+      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " +
+          dir_.path().string() + "\n",
       dir_.file("sim.yaml"));
   std::vector<RecordingProcessor::Seen> seen;
   {
@@ -332,7 +333,8 @@ TEST_F(DaemonTest, SimSourceDeliversTheSimulatorsFramesWholeAndInOrder) {
     EXPECT_EQ(seen[i].sequence, static_cast<uint64_t>(i));
     ASSERT_EQ(seen[i].hashes.size(), 2u);
     dataset.loadImages(i, images, present, nullptr);
-    for (int k = 0; k < 2; ++k) EXPECT_EQ(seen[i].hashes[k], imageHash(images[k].view())) << "frame " << i << " camera " << k;
+    for (int k = 0; k < 2; ++k)
+      EXPECT_EQ(seen[i].hashes[k], imageHash(images[k].view())) << "frame " << i << " camera " << k;
   }
 }
 

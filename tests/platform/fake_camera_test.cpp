@@ -1,7 +1,8 @@
 // Aravis for real: mcslamd acquires from Aravis's fake GigE Vision camera (arv-fake-gv-camera-0.8 on
 // 127.0.0.1, Debian package aravis-tools) in software-trigger mode, and frames flow through the whole
 // daemon to shared memory; a camera that disappears is reopened when it comes back. Also: an unreachable
-// camera, a trigger line the camera lacks and a missing GPIO chip end start-up with a message naming the key. Only loopback addresses are ever contacted.
+// camera, a trigger line the camera lacks and a missing GPIO chip end start-up with a message naming the key. Only
+// loopback addresses are ever contacted.
 #include <arv.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -75,7 +76,8 @@ std::string readAll(const std::string& path) {
 std::string aravisConfig(const std::string& calib, const std::string& camera_id, const std::string& extra) {
   return "calibration: " + calib +
          "\nsource:\n  type: aravis\n  aravis:\n    frame_timeout_ms: 3000\n    cameras:\n"
-         "      - {id: \"" + camera_id + "\", exposure_us: 2000, gain_db: 1, pixel_format: Mono8}\n" + extra;
+         "      - {id: \"" +
+         camera_id + "\", exposure_us: 2000, gain_db: 1, pixel_format: Mono8}\n" + extra;
 }
 }  // namespace
 
@@ -90,10 +92,11 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
 
   // 1. The mcslamd process: software trigger at 20 Hz, poses appear in shared memory; SIGTERM stops it.
   const std::string shm = "/mcslam-test-fakecam-" + std::to_string(getpid());
-  const std::string config = test::writeFile(dir.file("mcslamd.yaml"),
-      aravisConfig(calib, "127.0.0.1",
-                   "trigger:\n  mode: software\n  rate_hz: 20\nstatus_interval_s: 0.5\n"
-                   "publish:\n  shm:\n    name: " + shm + "\noutput:\n  directory: " + dir.path().string() + "\n"));
+  const std::string config = test::writeFile(
+      dir.file("mcslamd.yaml"), aravisConfig(calib, "127.0.0.1",
+                                             "trigger:\n  mode: software\n  rate_hz: 20\nstatus_interval_s: 0.5\n"
+                                             "publish:\n  shm:\n    name: " +
+                                                 shm + "\noutput:\n  directory: " + dir.path().string() + "\n"));
   const pid_t pid = ::fork();
   if (pid == 0) {
     const int fd = ::open(dir.file("log.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -127,11 +130,11 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
   // 2. In-process, to read the counters: images arrive, are assembled and processed, and the daemon's
   //    threads (acquisition included) allocate nothing per frame after warm-up.
   {
-    DaemonConfig c = parseDaemonConfig(
-        aravisConfig(calib, "127.0.0.1",
-                     "trigger:\n  mode: software\n  rate_hz: 50\nwarmup_frames: 20\n"
-                     "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " + dir.path().string() + "\n"),
-        dir.file("inproc.yaml"));
+    DaemonConfig c = parseDaemonConfig(aravisConfig(calib, "127.0.0.1",
+                                                    "trigger:\n  mode: software\n  rate_hz: 50\nwarmup_frames: 20\n"
+                                                    "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " +
+                                                        dir.path().string() + "\n"),
+                                       dir.file("inproc.yaml"));
     Daemon d(c, createPipeline(c.slam, c.file, c.rig));
     d.start();
     const auto until = Clock::now() + std::chrono::seconds(60);
@@ -152,11 +155,11 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
   // 3. A camera that disappears is reported lost and reopened; frames flow again once it is back,
   //    while the daemon keeps running.
   {
-    DaemonConfig c = parseDaemonConfig(
-        aravisConfig(calib, "127.0.0.1", "trigger:\n  mode: software\n  rate_hz: 20\n"
-                                         "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " +
-                                             dir.path().string() + "\n"),
-        dir.file("lost.yaml"));
+    DaemonConfig c = parseDaemonConfig(aravisConfig(calib, "127.0.0.1",
+                                                    "trigger:\n  mode: software\n  rate_hz: 20\n"
+                                                    "publish:\n  shm:\n    enabled: false\noutput:\n  directory: " +
+                                                        dir.path().string() + "\n"),
+                                       dir.file("lost.yaml"));
     c.aravis.frame_timeout_ms = 500;
     Daemon d(c, createPipeline(c.slam, c.file, c.rig));
     d.start();
@@ -179,7 +182,8 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
   //    it has, the missing GPIO chip is what fails, naming trigger.gpio_chip.
   const std::string gpio_trigger =
       "trigger:\n  mode: gpio\n  rate_hz: 20\n  gpio_chip: gpiochip-mcslam-missing\n  gpio_line: 4\n"
-      "output:\n  directory: " + dir.path().string() + "\n";
+      "output:\n  directory: " +
+      dir.path().string() + "\n";
   std::string out;
   const std::string bad_line = test::writeFile(dir.file("line.yaml"), aravisConfig(calib, "127.0.0.1", gpio_trigger));
   EXPECT_EQ(test::runCommand(test::binPath("mcslamd") + " --config " + bad_line, &out), 2) << out;

@@ -183,11 +183,17 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
 
   const std::string shm = "/mcslam-test-proc-" + std::to_string(getpid());
   const std::string config = test::writeFile(dir.file("mcslamd.yaml"),
-      "log_level: debug\nstatus_interval_s: 0.2\nwarmup_frames: 20\n"
-      "source:\n  type: dataset\n  dataset:\n    path: " + data + "\n    rate: fastest\n    at_end: loop\n"
-      "publish:\n  shm:\n    name: " + shm + "\n    mode: \"0640\"\n    ring_length: 256\n"
-      "  udp:\n    destinations: [\"127.0.0.1:" + std::to_string(ntohs(a.sin_port)) + "\"]\n"
-      "output:\n  directory: out\n  extrinsics: refined/extrinsics.yaml\n");
+                                             "log_level: debug\nstatus_interval_s: 0.2\nwarmup_frames: 20\n"
+                                             "source:\n  type: dataset\n  dataset:\n    path: " +
+                                                 data +
+                                                 "\n    rate: fastest\n    at_end: loop\n"
+                                                 "publish:\n  shm:\n    name: " +
+                                                 shm +
+                                                 "\n    mode: \"0640\"\n    ring_length: 256\n"
+                                                 "  udp:\n    destinations: [\"127.0.0.1:" +
+                                                 std::to_string(ntohs(a.sin_port)) +
+                                                 "\"]\n"
+                                                 "output:\n  directory: out\n  extrinsics: refined/extrinsics.yaml\n");
   std::filesystem::create_directories(dir.file("out/refined"));
   const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "400000", dir.file("log.txt"));
   ASSERT_GT(pid, 0);
@@ -255,7 +261,8 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
     ++row;
     if (r.frame_sequence < frames) {
       const Eigen::Quaterniond q(r.orientation[3], r.orientation[0], r.orientation[1], r.orientation[2]);
-      first_pass.push_back({r.capture_time_ns, SE3(q.toRotationMatrix(), Vec3(r.position[0], r.position[1], r.position[2]))});
+      first_pass.push_back(
+          {r.capture_time_ns, SE3(q.toRotationMatrix(), Vec3(r.position[0], r.position[1], r.position[2]))});
     }
   }
   EXPECT_EQ(rows.size(), row) << "the trajectory holds a line that was never published";
@@ -287,10 +294,11 @@ TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
   NotifyListener notify(dir.file("notify.sock"));
   ASSERT_TRUE(notify.ok());
   // Software trigger at 0.1 Hz: the first pulse (and so the first frame) is 10 s away.
-  const std::string config = test::writeFile(dir.file("mcslamd.yaml"),
-      "status_interval_s: 0.1\nsource:\n  type: dataset\n  dataset:\n    path: data\n"
-      "trigger:\n  mode: software\n  rate_hz: 0.1\n"
-      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
+  const std::string config =
+      test::writeFile(dir.file("mcslamd.yaml"),
+                      "status_interval_s: 0.1\nsource:\n  type: dataset\n  dataset:\n    path: data\n"
+                      "trigger:\n  mode: software\n  rate_hz: 0.1\n"
+                      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
   const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "100000", dir.file("log.txt"));
   ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));
   ASSERT_TRUE(waitFor([&] { return notify.count("STATUS=") >= 5; }));  // ticks happened (every 50 ms)
@@ -305,9 +313,10 @@ TEST(McslamdProcess, ImageCodecIsMappedOnlyWhenTheReplayMeetsAPng) {
   for (const std::string data : {"pgm", "pgm_png"}) {
     NotifyListener notify(dir.file(data + ".sock"));
     ASSERT_TRUE(notify.ok());
-    const std::string config = test::writeFile(dir.file(data + ".yaml"),
+    const std::string config = test::writeFile(
+        dir.file(data + ".yaml"),
         "status_interval_s: 0.1\nsource:\n  type: dataset\n  dataset:\n    path: " + data +
-        "\n    rate: fastest\n    at_end: loop\npublish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
+            "\n    rate: fastest\n    at_end: loop\npublish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
     const std::string log = dir.file(data + ".log");
     const pid_t pid = spawnDaemon(config, dir.file(data + ".sock"), "400000", log);
     // WATCHDOG=1 is sent only once frames are processed: their images were read by then.
@@ -324,8 +333,9 @@ TEST(McslamdProcess, ImageCodecIsMappedOnlyWhenTheReplayMeetsAPng) {
 TEST(McslamdProcess, BadConfigEndsStartupWithOneMessageNamingTheKey) {
   test::TempDir dir("mcslamd-bad");
   test::writeSmallDataset(dir.file("data"), 2, 2);
-  const std::string config = test::writeFile(dir.file("bad.yaml"),
-      "source:\n  type: dataset\n  dataset:\n    path: data\ncapacities:\n  pose_ring_slots: 0\n");
+  const std::string config =
+      test::writeFile(dir.file("bad.yaml"),
+                      "source:\n  type: dataset\n  dataset:\n    path: data\ncapacities:\n  pose_ring_slots: 0\n");
   std::string out;
   const int rc = test::runCommand(test::binPath("mcslamd") + " --config " + config, &out);
   EXPECT_EQ(rc, 2) << out;

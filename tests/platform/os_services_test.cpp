@@ -162,8 +162,10 @@ TEST(PixelConvert, BayerPatternsGiveTheGreyOfTheirColour) {
   const struct {
     PixelLayout layout;
     const char* cell;  // top-left 2x2 cell, row-major
-  } cases[] = {{PixelLayout::BayerRG8, "RGGB"}, {PixelLayout::BayerGR8, "GRBG"},
-               {PixelLayout::BayerGB8, "GBRG"}, {PixelLayout::BayerBG8, "BGGR"}};
+  } cases[] = {{PixelLayout::BayerRG8, "RGGB"},
+               {PixelLayout::BayerGR8, "GRBG"},
+               {PixelLayout::BayerGB8, "GBRG"},
+               {PixelLayout::BayerBG8, "BGGR"}};
   for (const auto& c : cases) {
     std::vector<uint8_t> raw(w * h);
     for (int y = 0; y < h; ++y)

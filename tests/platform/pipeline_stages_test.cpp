@@ -32,7 +32,8 @@ struct LoadedFrame {
 
 bool samePose(const PoseEstimate& a, const PoseEstimate& b) {
   return a.t == b.t && a.sequence == b.sequence && a.state == b.state && a.is_keyframe == b.is_keyframe &&
-         a.valid == b.valid && a.quality == b.quality && std::memcmp(a.T_w_b.t.data(), b.T_w_b.t.data(), 3 * sizeof(double)) == 0 &&
+         a.valid == b.valid && a.quality == b.quality &&
+         std::memcmp(a.T_w_b.t.data(), b.T_w_b.t.data(), 3 * sizeof(double)) == 0 &&
          std::memcmp(a.T_w_b.R.data(), b.T_w_b.R.data(), 9 * sizeof(double)) == 0;
 }
 

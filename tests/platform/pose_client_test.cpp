@@ -32,7 +32,8 @@ std::string printed(const pose::PoseRecord& r) {
 TEST(PoseClientPy, DecodesTheDaemonsDatagramsLikeTheCppTools) {
   if (test::runCommand("python3 --version") != 0) GTEST_SKIP() << "python3 is not installed";
   const std::string script = std::string(MCSLAM_TEST_DATA_DIR) + "/../../tools/pose_client.py";
-  std::FILE* client = ::popen(("python3 " + script + " --bind 127.0.0.1 --port 0 --count 3 --timeout 20 2>&1").c_str(), "r");
+  std::FILE* client =
+      ::popen(("python3 " + script + " --bind 127.0.0.1 --port 0 --count 3 --timeout 20 2>&1").c_str(), "r");
   ASSERT_NE(client, nullptr);
   const std::string hello = readLine(client);  // "listening on 127.0.0.1:PORT"
   const auto colon = hello.rfind(':');

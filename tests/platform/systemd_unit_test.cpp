@@ -19,9 +19,9 @@ std::string unitText() {
 TEST(SystemdUnit, HasNotifyWatchdogRestartDedicatedUserAndHardening) {
   const std::string unit = unitText();
   ASSERT_FALSE(unit.empty());
-  for (const char* line : {"Type=notify", "WatchdogSec=", "Restart=on-failure", "DynamicUser=yes", "NoNewPrivileges=yes",
-                           "ProtectSystem=strict", "StateDirectory=mcslamd", "LimitRTPRIO=",
-                           "ExecStart=/usr/local/bin/mcslamd --config "})
+  for (const char* line :
+       {"Type=notify", "WatchdogSec=", "Restart=on-failure", "DynamicUser=yes", "NoNewPrivileges=yes",
+        "ProtectSystem=strict", "StateDirectory=mcslamd", "LimitRTPRIO=", "ExecStart=/usr/local/bin/mcslamd --config "})
     EXPECT_NE(unit.find(std::string("\n") + line), std::string::npos) << line;
   EXPECT_EQ(unit.find("ReadWritePaths="), std::string::npos) << "the state directory must be the only writable path";
 }

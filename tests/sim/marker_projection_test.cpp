@@ -99,8 +99,8 @@ Scene markerScene(const CameraModel& cam, const SE3& T_w_c, double pixels) {
 }
 
 struct Residuals {
-  int found = 0;        // markers with a blob
-  double max_px = 0;    // largest centroid - projection distance
+  int found = 0;      // markers with a blob
+  double max_px = 0;  // largest centroid - projection distance
 };
 
 // Projects every marker with `model` (at pose T_w_c) and pairs it with the nearest blob, one blob per marker.
@@ -137,7 +137,8 @@ void checkCamera(const CameraModel& model, const char* what) {
   rig.cameras.push_back(RigCamera{"cam0", model, SE3(), 0});
   // An arbitrary, non-axis-aligned camera pose.
   const Mat3 R = (Eigen::AngleAxisd(0.7, Vec3::UnitZ()) * Eigen::AngleAxisd(-1.9, Vec3::UnitX()) *
-                  Eigen::AngleAxisd(0.2, Vec3::UnitY())).toRotationMatrix();
+                  Eigen::AngleAxisd(0.2, Vec3::UnitY()))
+                     .toRotationMatrix();
   const SE3 T_w_c(R, Vec3(1.0, -2.0, 1.3));
   const Scene scene = markerScene(model, T_w_c, 6.0);
 

@@ -62,10 +62,28 @@ TEST(SimCli, BadNumbersAreNamed) {
 TEST(SimCli, HelpDocumentsEveryOption) {
   std::string out;
   ASSERT_EQ(runSim("--help", &out), 0);
-  for (const char* option : {"--rig", "--world", "--trajectory", "--frames", "--rate", "--seed", "--out", "--cameras",
-                             "--moving-objects", "--textures", "--no-depth", "--no-noise", "--no-exposure-variation",
-                             "--no-vignetting", "--no-antialiasing", "--motion-blur", "--threads", "--overwrite",
-                             "--quiet", "--preview", "--preview-frame", "--preview-scale"}) {
+  for (const char* option : {"--rig",
+                             "--world",
+                             "--trajectory",
+                             "--frames",
+                             "--rate",
+                             "--seed",
+                             "--out",
+                             "--cameras",
+                             "--moving-objects",
+                             "--textures",
+                             "--no-depth",
+                             "--no-noise",
+                             "--no-exposure-variation",
+                             "--no-vignetting",
+                             "--no-antialiasing",
+                             "--motion-blur",
+                             "--threads",
+                             "--overwrite",
+                             "--quiet",
+                             "--preview",
+                             "--preview-frame",
+                             "--preview-scale"}) {
     EXPECT_NE(out.find(option), std::string::npos) << option;
   }
 }

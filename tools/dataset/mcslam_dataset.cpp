@@ -41,11 +41,11 @@ void printInfoText(const Dataset& ds) {
     std::printf("  %-6s %4dx%-4d pinhole/%s\n", ds.rig().cameras[c].name.c_str(), m.width(), m.height(),
                 distortionName(m.distortion()));
   }
-  std::printf("rig frames: %zu (%zu with every camera), %.2f s, %.2f Hz; sync tolerance %.3f ms\n", ds.size(), s.complete,
-              s.duration_s, s.rate_hz, static_cast<double>(ds.syncToleranceNs()) * 1e-6);
+  std::printf("rig frames: %zu (%zu with every camera), %.2f s, %.2f Hz; sync tolerance %.3f ms\n", ds.size(),
+              s.complete, s.duration_s, s.rate_hz, static_cast<double>(ds.syncToleranceNs()) * 1e-6);
   if (ds.groundTruth()) {
-    std::printf("ground truth: %zu poses, %.2f m of path (%s)\n", ds.groundTruth()->size(), pathLength(*ds.groundTruth()),
-                ds.groundTruthPath().c_str());
+    std::printf("ground truth: %zu poses, %.2f m of path (%s)\n", ds.groundTruth()->size(),
+                pathLength(*ds.groundTruth()), ds.groundTruthPath().c_str());
   } else {
     std::printf("ground truth: none\n");
   }
@@ -90,8 +90,9 @@ int main(int argc, char** argv) {
   bool json = false;
   auto* info = app.add_subcommand("info", "Layout, cameras, rig frames, rate and ground truth of a dataset folder");
   info->add_option("DATASET", dir, "Dataset folder (native ASL, EuRoC mav0/ or KITTI sequence)")->required();
-  info->add_flag("--json", json, "Print JSON (keys: folder, layout, cameras, rig_frames, complete_rig_frames, duration_s, "
-                                 "rate_hz, ground_truth_poses, ground_truth_path_m, warnings)");
+  info->add_flag("--json", json,
+                 "Print JSON (keys: folder, layout, cameras, rig_frames, complete_rig_frames, duration_s, "
+                 "rate_hz, ground_truth_poses, ground_truth_path_m, warnings)");
   info->add_option("--cameras", cameras, "Only these cameras, by calibration index, e.g. 0,1");
 
   std::string layout, out, images = "original";
@@ -103,11 +104,13 @@ int main(int argc, char** argv) {
   convert->add_option("DATASET", dir, "Dataset folder to read (any layout)")->required();
   convert->add_option("--layout", layout, "asl, euroc or kitti")->required();
   convert->add_option("--out", out, "Output folder (must not exist or be empty)")->required();
-  convert->add_option("--cameras", cameras, "Write only these cameras, by calibration index, e.g. 1,2 (the first "
-                                            "becomes the written cam0)");
-  convert->add_option("--images", images,
-                      "original (hard links of the files) or pgm (every image written as binary 8-bit PGM, asl and "
-                      "euroc only: a replay that needs no image codec, e.g. for mcslamd)")
+  convert->add_option("--cameras", cameras,
+                      "Write only these cameras, by calibration index, e.g. 1,2 (the first "
+                      "becomes the written cam0)");
+  convert
+      ->add_option("--images", images,
+                   "original (hard links of the files) or pgm (every image written as binary 8-bit PGM, asl and "
+                   "euroc only: a replay that needs no image codec, e.g. for mcslamd)")
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
@@ -126,8 +129,10 @@ int main(int argc, char** argv) {
                   r.ground_truth_poses);
     } else {
       const Dataset ds = Dataset::open(dir, options);
-      if (json) printInfoJson(ds);
-      else printInfoText(ds);
+      if (json)
+        printInfoJson(ds);
+      else
+        printInfoText(ds);
     }
   } catch (const InputError& e) {
     std::fprintf(stderr, "mcslam-dataset: %s\n", e.what());

@@ -72,14 +72,17 @@ void jsonFooter(JsonWriter& j, const AlignedTrajectories& d, double rmse_percent
 }
 
 std::string viewTail(const EvalOptions& o, const Inputs& in, std::size_t pairs) {
-  return std::string(o.align == AlignMode::None ? "not aligned" : o.align == AlignMode::SE3 ? "SE(3) aligned" : "Sim(3) aligned") +
+  return std::string(o.align == AlignMode::None  ? "not aligned"
+                     : o.align == AlignMode::SE3 ? "SE(3) aligned"
+                                                 : "Sim(3) aligned") +
          ", " + std::to_string(pairs) + " pairs  |  reference: " + fileName(in.reference_path) +
          "  |  estimate: " + fileName(in.estimate_path);
 }
 
 std::string estimateLabel(const EvalOptions& o) {
-  return o.align == AlignMode::None ? "estimate" : o.align == AlignMode::SE3 ? "estimate (SE(3) aligned)"
-                                                                               : "estimate (Sim(3) aligned)";
+  return o.align == AlignMode::None  ? "estimate"
+         : o.align == AlignMode::SE3 ? "estimate (SE(3) aligned)"
+                                     : "estimate (Sim(3) aligned)";
 }
 
 std::string deltaText(const RpeOptions& o) {
@@ -131,14 +134,16 @@ void plotApe(const std::string& png, const ApeResult& r, const EvalOptions& o, c
 }
 
 void printRpeText(const RpeResult& r, const RpeOptions& o, const Inputs& in) {
-  std::printf("RPE for delta = %s, %s pairs from the %s\n", deltaText(o).c_str(),
-              o.all_pairs ? "all" : "consecutive", o.pairs_from_reference ? "reference" : "estimate");
+  std::printf("RPE for delta = %s, %s pairs from the %s\n", deltaText(o).c_str(), o.all_pairs ? "all" : "consecutive",
+              o.pairs_from_reference ? "reference" : "estimate");
   printHeader(o.eval, in, r.data.ref.size());
   const ErrorStats& t = r.translation;
   const ErrorStats& a = r.rotation_deg;
   std::printf("  pairs        %zu\n", t.count);
   std::printf("               translation (m)  rotation (deg)\n");
-  const auto row = [](const char* name, double tv, double av) { std::printf("  %-11s  %-15.6f  %.6f\n", name, tv, av); };
+  const auto row = [](const char* name, double tv, double av) {
+    std::printf("  %-11s  %-15.6f  %.6f\n", name, tv, av);
+  };
   row("rmse", t.rmse, a.rmse);
   row("mean", t.mean, a.mean);
   row("median", t.median, a.median);
@@ -169,8 +174,8 @@ void printRpeJson(const RpeResult& r, const RpeOptions& o, const Inputs& in) {
 
 void plotRpe(const std::string& png, const RpeResult& r, const RpeOptions& o, const Inputs& in) {
   TrajectoryPlot p;
-  p.title = "RPE (translation, delta " + deltaText(o) + "): rmse " + format("%.4g m", r.translation.rmse) + ", rotation rmse " +
-            format("%.3g deg", r.rotation_deg.rmse);
+  p.title = "RPE (translation, delta " + deltaText(o) + "): rmse " + format("%.4g m", r.translation.rmse) +
+            ", rotation rmse " + format("%.3g deg", r.rotation_deg.rmse);
   p.subtitle = viewTail(o.eval, in, r.translation.count);
   p.reference = positionsOf(r.data.ref);
   p.estimate = positionsOf(r.data.est);

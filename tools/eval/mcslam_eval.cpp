@@ -26,8 +26,9 @@ struct CommonArgs {
 };
 
 void addCommon(CLI::App* cmd, CommonArgs& a) {
-  cmd->add_option("GT", a.reference,
-                  "Reference (ground truth) trajectory, or a dataset folder (ASL, EuRoC, KITTI) to use its ground truth")
+  cmd->add_option(
+         "GT", a.reference,
+         "Reference (ground truth) trajectory, or a dataset folder (ASL, EuRoC, KITTI) to use its ground truth")
       ->required();
   cmd->add_option("EST", a.estimate, "Estimated trajectory")->required();
   cmd->add_option("--align", a.align,
@@ -91,9 +92,9 @@ int main(int argc, char** argv) {
   double delta = 1;
   std::string delta_unit = "f";
   bool all_pairs = false, pairs_from_reference = false;
-  auto* rpe = app.add_subcommand(
-      "rpe",
-      "Relative pose error over index pairs (i, j): translation (m) and rotation (deg) of (Q_i^-1 Q_j)^-1 (P_i^-1 P_j)");
+  auto* rpe = app.add_subcommand("rpe",
+                                 "Relative pose error over index pairs (i, j): translation (m) and rotation (deg) of "
+                                 "(Q_i^-1 Q_j)^-1 (P_i^-1 P_j)");
   addCommon(rpe, rpe_args);
   rpe->add_option("--delta", delta, "Distance between the poses of a pair, in --delta-unit")->capture_default_str();
   rpe->add_option("--delta-unit", delta_unit,
@@ -127,8 +128,10 @@ int main(int argc, char** argv) {
       const EvalOptions o = evalOptions(a);
       const ApeResult r = computeApe(ref, est, o);
       if (!a.plot.empty()) eval_tool::plotApe(a.plot, r, o, in);
-      if (a.json) eval_tool::printApeJson(r, o, in);
-      else eval_tool::printApeText(r, o, in);
+      if (a.json)
+        eval_tool::printApeJson(r, o, in);
+      else
+        eval_tool::printApeText(r, o, in);
     } else {
       RpeOptions o;
       o.eval = evalOptions(a);
@@ -138,8 +141,10 @@ int main(int argc, char** argv) {
       o.pairs_from_reference = pairs_from_reference;
       const RpeResult r = computeRpe(ref, est, o);
       if (!a.plot.empty()) eval_tool::plotRpe(a.plot, r, o, in);
-      if (a.json) eval_tool::printRpeJson(r, o, in);
-      else eval_tool::printRpeText(r, o, in);
+      if (a.json)
+        eval_tool::printRpeJson(r, o, in);
+      else
+        eval_tool::printRpeText(r, o, in);
     }
   } catch (const InputError& e) {
     std::fprintf(stderr, "mcslam-eval: %s\n", e.what());

@@ -89,14 +89,16 @@ int main(int argc, char** argv) {
       printJson(features, frame);
     } else {
       const MultiViewStats& s = front.multiViewStats();
-      std::printf("frame %zu: %d keypoints in %d cameras, %d multi-view features (%d with a point, %d metric), %d mono\n",
-                  frame, features.keypointCount(), ds.rig().size(), features.mv_count, s.tracks_with_point,
-                  s.metric_tracks, features.monoCount());
+      std::printf(
+          "frame %zu: %d keypoints in %d cameras, %d multi-view features (%d with a point, %d metric), %d mono\n",
+          frame, features.keypointCount(), ds.rig().size(), features.mv_count, s.tracks_with_point, s.metric_tracks,
+          features.monoCount());
       // How well the points are known: what initialization and landmark creation select by.
       int within[4] = {0, 0, 0, 0};
       const double bounds[4] = {0.01, 0.03, 0.06, 0.15};
       for (int t = 0; t < features.mv_count; ++t) {
-        for (int b = 0; b < 4; ++b) within[b] += features.mv[t].has_point && features.mv[t].relative_depth_sigma <= bounds[b];
+        for (int b = 0; b < 4; ++b)
+          within[b] += features.mv[t].has_point && features.mv[t].relative_depth_sigma <= bounds[b];
       }
       std::printf("points by relative depth sigma: <=1%% %d, <=3%% %d, <=6%% %d, <=15%% %d\n", within[0], within[1],
                   within[2], within[3]);

@@ -89,13 +89,16 @@ int main(int argc, char** argv) {
   std::string calib;
   bool json = false;
   auto* info = app.add_subcommand("info", "Cameras, models, resolutions, poses in the body frame and baselines");
-  info->add_option("CALIB", calib, "Kalibr camchain/imu-camchain YAML, EuRoC sensor.yaml, KITTI calib.txt or a dataset folder")
+  info->add_option("CALIB", calib,
+                   "Kalibr camchain/imu-camchain YAML, EuRoC sensor.yaml, KITTI calib.txt or a dataset folder")
       ->required();
-  info->add_flag("--json", json, "Print JSON (keys: cameras[index, model, distortion, resolution, position, direction], baselines)");
+  info->add_flag("--json", json,
+                 "Print JSON (keys: cameras[index, model, distortion, resolution, position, direction], baselines)");
 
   OverlapOptions overlap;
   std::string png_dir;
-  auto* ov = app.add_subcommand("overlap", "Overlap between camera pairs (paper eq. 1-2, full camera models, a depth range)");
+  auto* ov =
+      app.add_subcommand("overlap", "Overlap between camera pairs (paper eq. 1-2, full camera models, a depth range)");
   ov->add_option("CALIB", calib, "Calibration (as for info)")->required();
   ov->add_flag("--json", json, "Print JSON (keys: pairs[cameras, fraction], fraction_matrix)");
   ov->add_option("--png", png_dir, "Write one picture of the cells per overlapping camera pair into this folder");
@@ -107,10 +110,12 @@ int main(int argc, char** argv) {
   double translation = 0.02, rotation_deg = 1.0;
   uint64_t seed = 1;
   std::string out_path, other;
-  auto* perturb = app.add_subcommand("perturb", "Move one camera's extrinsic (what-if calibration error); writes Kalibr YAML");
+  auto* perturb =
+      app.add_subcommand("perturb", "Move one camera's extrinsic (what-if calibration error); writes Kalibr YAML");
   perturb->add_option("CALIB", calib, "Calibration (as for info)")->required();
   perturb->add_option("--camera", camera, "Camera index")->required();
-  perturb->add_option("--translation", translation, "Translation error, metres (random direction)")->capture_default_str();
+  perturb->add_option("--translation", translation, "Translation error, metres (random direction)")
+      ->capture_default_str();
   perturb->add_option("--rotation-deg", rotation_deg, "Rotation error, degrees (random axis)")->capture_default_str();
   perturb->add_option("--seed", seed, "Seed of the direction and axis")->capture_default_str();
   perturb->add_option("--out", out_path, "Kalibr camchain YAML to write")->required();
@@ -119,21 +124,27 @@ int main(int argc, char** argv) {
   compare->add_option("OTHER", other, "Second calibration (e.g. mcslam-run --extrinsics output)")->required();
   compare->add_flag("--json", json, "Print JSON (keys: cameras[index, translation_m, rotation_deg])");
   std::string subset;
-  compare->add_option("--cameras", subset, "Compare only these cameras of CALIB (e.g. 0,1,2,3,4: OTHER holds that subset)");
+  compare->add_option("--cameras", subset,
+                      "Compare only these cameras of CALIB (e.g. 0,1,2,3,4: OTHER holds that subset)");
   CLI11_PARSE(app, argc, argv);
   try {
     const Rig rig = loadRigFromPath(calib);
     if (perturb->parsed()) {
       writeKalibrRig(rigtool::perturbExtrinsic(rig, camera, translation, rotation_deg, seed), out_path);
     } else if (compare->parsed()) {
-      rigtool::printComparison(subset.empty() ? rig : rig.subset(parseCameraList(subset)), loadRigFromPath(other), json);
+      rigtool::printComparison(subset.empty() ? rig : rig.subset(parseCameraList(subset)), loadRigFromPath(other),
+                               json);
     } else if (info->parsed()) {
-      if (json) printInfoJson(rig);
-      else printInfoText(rig, calib);
+      if (json)
+        printInfoJson(rig);
+      else
+        printInfoText(rig, calib);
     } else {
       const OverlapMap map(rig, overlap);
-      if (json) rigtool::printOverlapJson(rig, map);
-      else rigtool::printOverlapText(rig, map);
+      if (json)
+        rigtool::printOverlapJson(rig, map);
+      else
+        rigtool::printOverlapText(rig, map);
       if (!png_dir.empty()) {
         const int n = rigtool::writeOverlapPngs(rig, map, png_dir);
         std::fprintf(stderr, "mcslam-rig: wrote %d picture%s to %s\n", n, n == 1 ? "" : "s", png_dir.c_str());

@@ -76,7 +76,8 @@ int writeOverlapPngs(const Rig& rig, const OverlapMap& map, const std::string& d
       const CellGrid& gi = map.grid(i);
       const CellGrid& gj = map.grid(j);
       const int gap = 30, top = 40;
-      cv::Mat canvas(std::max(gi.height, gj.height) + top, gi.width + gap + gj.width, CV_8UC3, cv::Scalar(255, 255, 255));
+      cv::Mat canvas(std::max(gi.height, gj.height) + top, gi.width + gap + gj.width, CV_8UC3,
+                     cv::Scalar(255, 255, 255));
       cv::Mat body = canvas(cv::Rect(0, top, canvas.cols, canvas.rows - top));
       std::vector<cv::Scalar> ci(gi.cells(), none), cj(gj.cells(), none);
       // The example cell: the overlapping cell of i nearest the image centre.
@@ -101,8 +102,9 @@ int writeOverlapPngs(const Rig& rig, const OverlapMap& map, const std::string& d
       drawGrid(body, gi, 0, ci);
       drawGrid(body, gj, gi.width + gap, cj);
       char title[160];
-      std::snprintf(title, sizeof(title), "cam%d (left) into cam%d (right): %.0f%% of cam%d overlaps; red cell -> orange candidates",
-                    i, j, 100.0 * map.overlapFraction(i, j), i);
+      std::snprintf(title, sizeof(title),
+                    "cam%d (left) into cam%d (right): %.0f%% of cam%d overlaps; red cell -> orange candidates", i, j,
+                    100.0 * map.overlapFraction(i, j), i);
       cv::putText(canvas, title, cv::Point(8, 27), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
       const std::string path = dir + "/overlap_cam" + std::to_string(i) + "_cam" + std::to_string(j) + ".png";
       if (!cv::imwrite(path, canvas)) throw InputError(path + ": cannot write image");

@@ -2,8 +2,8 @@
 // every frame, the keyframes, per-stage timing and tracking statistics.
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -31,21 +31,25 @@ struct RunOptions {
 };
 
 void addOptions(CLI::App& app, RunOptions& o) {
-  app.add_option("--dataset", o.dataset_dir, "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
+  app.add_option("--dataset", o.dataset_dir,
+                 "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
       ->required();
-  app.add_option("--config", o.config_path, "YAML file with a `slam:` section (see config/slam.yaml); defaults otherwise");
+  app.add_option("--config", o.config_path,
+                 "YAML file with a `slam:` section (see config/slam.yaml); defaults otherwise");
   app.add_option("--calibration", o.calibration_path,
                  "Calibration to use instead of the dataset's own (Kalibr YAML, EuRoC sensor.yaml, KITTI calib.txt)");
-  app.add_option("--cameras", o.cameras_text, "Cameras of the rig to use, by calibration index, e.g. 0,1,2 (default: all)");
+  app.add_option("--cameras", o.cameras_text,
+                 "Cameras of the rig to use, by calibration index, e.g. 0,1,2 (default: all)");
   app.add_option("--out", o.out_path, "Trajectory of every frame, TUM format (pose of the body in the world)");
   app.add_option("--keyframes", o.keyframes_path, "Keyframe poses, TUM format");
   app.add_option("--stats", o.stats_path, "Timing per stage (mean, p99) and tracking states, JSON");
   app.add_option("--extrinsics", o.extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", o.max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", o.quiet, "No progress bar");
-  app.add_option("--log-level", o.log_level, "Log of the pipeline's events (debug: also each scale estimate of a rig "
-                                             "without overlap; trace: also every frame's tracking attempts, inliers, "
-                                             "keyframes and new landmarks)")
+  app.add_option("--log-level", o.log_level,
+                 "Log of the pipeline's events (debug: also each scale estimate of a rig "
+                 "without overlap; trace: also every frame's tracking attempts, inliers, "
+                 "keyframes and new landmarks)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   app.add_flag("--overlap,!--no-overlap", o.overlap,
                "Run the front-end of the next frame while the odometry works on this one (the default; same output). "
@@ -109,7 +113,7 @@ class Console {
     if (quiet_ || i == 0) return;
     // Say when the poses are not in metres (pose.metric): a rig without overlap until its scale is found.
     const char* unit = pose.state != TrackingState::Tracking || pose.metric ? ""
-                       : cameras == 1 ? " up to scale (one camera)"
+                       : cameras == 1                                       ? " up to scale (one camera)"
                                       : " up to scale (no two cameras overlap: the scale is searched in turns)";
     std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s%s\n", show_ ? "\r\033[K" : "", i, toSeconds(pose.t),
                  trackingStateName(pose.state), unit);
@@ -203,7 +207,8 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, std::size_t frames, 
 
 void printSummary(const SlamPipeline& pipeline, const run::RunReport& report, double wall) {
   const OdometryStats& s = pipeline.stats();
-  std::fprintf(stderr, "mcslam-run: %llu frames in %.1f s: %llu tracked, %llu lost, %llu not initialized, %llu keyframes\n",
+  std::fprintf(stderr,
+               "mcslam-run: %llu frames in %.1f s: %llu tracked, %llu lost, %llu not initialized, %llu keyframes\n",
                static_cast<unsigned long long>(s.frames), wall, static_cast<unsigned long long>(s.tracking),
                static_cast<unsigned long long>(s.lost), static_cast<unsigned long long>(s.not_initialized),
                static_cast<unsigned long long>(s.keyframes));

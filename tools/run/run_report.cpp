@@ -77,8 +77,8 @@ Summary summarize(std::vector<double> v) {
 
 }  // namespace
 
-void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline, const std::string& dataset, int cameras,
-                           double wall_seconds) const {
+void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline, const std::string& dataset,
+                           int cameras, double wall_seconds) const {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw InputError(path + ": cannot write stats file");
   std::vector<double> features, tracking, optimization, total;

@@ -13,7 +13,7 @@ struct FrameRecord {
   Timestamp t = 0;
   PoseEstimate pose;
   PipelineTiming timing;
-  bool interpolated = false;  // filled in after a two-frame initialization
+  bool interpolated = false;   // filled in after a two-frame initialization
   bool unknown_scale = false;  // its position is not in metres (one camera; a rig without overlap before its scale)
 };
 

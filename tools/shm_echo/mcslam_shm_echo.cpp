@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <thread>
 
-#include "pose_print.hpp"
 #include "mcslam/pose_shm.hpp"
+#include "pose_print.hpp"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;

@@ -1,17 +1,17 @@
 // mcslam-sim: renders a multi-camera sequence with exact ground truth and writes it as an ASL dataset.
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 
+#include "contact_sheet.hpp"
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/time.hpp"
 #include "mcslam/sim/dataset_export.hpp"
 #include "mcslam/sim/rig_presets.hpp"
 #include "mcslam/sim/simulation.hpp"
-#include "contact_sheet.hpp"
 
 using namespace mcslam;
 namespace fs = std::filesystem;
@@ -19,9 +19,8 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string footer() {
-  return "\nRIG presets (or give a Kalibr camchain file):\n" + sim::describeRigPresets() +
-         "\nWORLDs:\n" + sim::describeWorlds() +
-         "\nTRAJectories:\n" + sim::describeTrajectories() +
+  return "\nRIG presets (or give a Kalibr camchain file):\n" + sim::describeRigPresets() + "\nWORLDs:\n" +
+         sim::describeWorlds() + "\nTRAJectories:\n" + sim::describeTrajectories() +
          "\nOutput (native ASL layout, read by mcslam::Dataset):\n"
          "  DIR/camchain.yaml            the written cameras; body frame = the first written camera\n"
          "  DIR/camN/data.csv, data/     8-bit grey PNG images named <stamp ns>.png\n"
@@ -115,12 +114,15 @@ void addOptions(CLI::App& app, SimOptions& o) {
   app.add_option("--trajectory", cfg.trajectory, "ground, handheld or file:PATH (TUM)")->capture_default_str();
   app.add_option("--frames", cfg.frames, "Frames to render; 0 = the whole trajectory")->capture_default_str();
   app.add_option("--rate", cfg.rate_hz, "Frame rate in Hz (the motion is in physical time)")->capture_default_str();
-  app.add_option("--seed", cfg.seed, "Seed of the world's layout and textures, the motion's wobble and the sensor noise")
+  app.add_option("--seed", cfg.seed,
+                 "Seed of the world's layout and textures, the motion's wobble and the sensor noise")
       ->capture_default_str();
   app.add_option("--out", o.out, "Output folder")->capture_default_str();
-  app.add_option("--cameras", o.cameras, "Cameras to write, by index, e.g. 0,2,4 (default: all); the first is the body");
+  app.add_option("--cameras", o.cameras,
+                 "Cameras to write, by index, e.g. 0,2,4 (default: all); the first is the body");
   app.add_flag("--moving-objects", cfg.moving_objects, "People-sized boxes walking through the scene");
-  app.add_option("--textures", cfg.textures_dir, "Folder of photographs (PNG/JPG) to use instead of procedural textures");
+  app.add_option("--textures", cfg.textures_dir,
+                 "Folder of photographs (PNG/JPG) to use instead of procedural textures");
   app.add_flag("--no-depth", o.no_depth, "Do not write depth images");
   app.add_flag("--no-noise", o.no_noise, "No sensor noise");
   app.add_flag("--no-exposure-variation", o.no_exposure, "Same gain for every camera and frame");
@@ -134,7 +136,8 @@ void addOptions(CLI::App& app, SimOptions& o) {
   app.add_option("--preview", o.preview,
                  "Write a contact sheet (PNG) of one frame of the selected cameras; without --out, only that");
   app.add_option("--preview-frame", o.preview_frame, "Frame shown by --preview")->capture_default_str();
-  app.add_option("--preview-scale", o.preview_scale, "Size of each camera in the contact sheet, relative to its resolution")
+  app.add_option("--preview-scale", o.preview_scale,
+                 "Size of each camera in the contact sheet, relative to its resolution")
       ->capture_default_str();
 }
 
@@ -173,8 +176,10 @@ void writeDataset(sim::Simulation& simulation, const SimOptions& o, sim::ExportO
   options.description = "mcslam-sim --rig " + cfg.rig + " --world " + cfg.world + " --trajectory " + cfg.trajectory;
   if (!o.quiet) {
     options.progress = [tty](int done, int total) {
-      if (tty) std::fprintf(stderr, "\r  frame %d/%d", done, total);
-      else if (done % 100 == 0 || done == total) std::fprintf(stderr, "  frame %d/%d\n", done, total);
+      if (tty)
+        std::fprintf(stderr, "\r  frame %d/%d", done, total);
+      else if (done % 100 == 0 || done == total)
+        std::fprintf(stderr, "  frame %d/%d\n", done, total);
       if (tty && done == total) std::fprintf(stderr, "\n");
     };
   }

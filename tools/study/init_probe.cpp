@@ -90,8 +90,11 @@ int main(int argc, char** argv) {
         good += within ? 1 : 0;
         std::printf("%5zu %4d %8.1f %9.3f %8.3f %6.3f %12.3f  %s  %d/%zu\n", r, gap,
                     Eigen::AngleAxisd(truth.R).angle() * 180.0 / M_PI, truth.t.norm(), res.T_1_2.t.norm(), scale,
-                    res.relative_scale_sigma, ok ? "accepted" : !observable ? "scale_unobservable" : relativePoseStatusName(res.status), res.num_inliers,
-                    init.lastCorrespondences().size());
+                    res.relative_scale_sigma,
+                    ok            ? "accepted"
+                    : !observable ? "scale_unobservable"
+                                  : relativePoseStatusName(res.status),
+                    res.num_inliers, init.lastCorrespondences().size());
       }
     }
     std::printf("pairs %d: accepted %d (scale within 5%%: %d); scale within 5%% over all pairs: %d\n", pairs, accepted,

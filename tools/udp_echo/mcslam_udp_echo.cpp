@@ -1,10 +1,10 @@
 // mcslam-udp-echo: receives mcslamd's UDP pose datagrams and prints them (same format as
 // mcslam-shm-echo). Reports datagrams that are not pose records and gaps in the sequence.
-#include <CLI/CLI.hpp>
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <cerrno>
 #include <cstdio>
@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (timeout_s > 0) {
-    timeval tv{static_cast<time_t>(timeout_s), static_cast<suseconds_t>((timeout_s - static_cast<long>(timeout_s)) * 1e6)};
+    timeval tv{static_cast<time_t>(timeout_s),
+               static_cast<suseconds_t>((timeout_s - static_cast<long>(timeout_s)) * 1e6)};
     ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
   }
   uint8_t buf[2048];

@@ -17,8 +17,8 @@ namespace mcslam::platform {
 
 struct AssemblyConfig {
   RigAssembler::MatchBy match_by = RigAssembler::MatchBy::TriggerCount;
-  double tolerance_ms = 5;   // timestamp matching
-  double timeout_ms = 200;   // a rig frame still incomplete after this goes out partial
+  double tolerance_ms = 5;  // timestamp matching
+  double timeout_ms = 200;  // a rig frame still incomplete after this goes out partial
 };
 
 struct CapacityConfig {
@@ -56,7 +56,7 @@ struct DaemonConfig {
   double status_interval_s = 1.0;
   double warmup_frames = 50;  // allocations are counted after this many processed frames
   SourceType source_type = SourceType::Dataset;
-  std::string calibration;   // Kalibr camchain; optional for a dataset (it has its own)
+  std::string calibration;  // Kalibr camchain; optional for a dataset (it has its own)
   DatasetSourceConfig dataset;
   SimSourceConfig sim;
   AravisSourceConfig aravis;

@@ -14,10 +14,10 @@ namespace mcslam::platform {
 
 // A synchronized capture of the whole rig (assembly -> processing).
 struct RigFrame {
-  std::vector<Image> images;          // one per camera, each sized for its camera
-  std::unique_ptr<bool[]> present;    // which cameras contributed
-  Timestamp capture_ns = 0;           // stamp of the first image that arrived (the matching key)
-  uint64_t sequence = 0;              // trigger index of the rig frame
+  std::vector<Image> images;        // one per camera, each sized for its camera
+  std::unique_ptr<bool[]> present;  // which cameras contributed
+  Timestamp capture_ns = 0;         // stamp of the first image that arrived (the matching key)
+  uint64_t sequence = 0;            // trigger index of the rig frame
   int64_t trigger_mono_ns = 0;
   int cameras = 0;
 

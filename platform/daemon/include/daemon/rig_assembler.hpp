@@ -17,8 +17,8 @@ class RigAssembler {
   enum class MatchBy { TriggerCount, Timestamp };
 
   // sizes: image size per camera.
-  RigAssembler(const std::vector<std::pair<int, int>>& sizes, uint32_t pending, MatchBy match_by,
-               int64_t tolerance_ns, int64_t timeout_ns);
+  RigAssembler(const std::vector<std::pair<int, int>>& sizes, uint32_t pending, MatchBy match_by, int64_t tolerance_ns,
+               int64_t timeout_ns);
 
   // Takes camera `cam`'s frame (its image buffer is swapped with a spare of the same size, so the
   // caller's slot stays usable). `now_mono_ns` drives the timeout. Returns false, taking nothing, when
@@ -31,7 +31,7 @@ class RigAssembler {
 
   // Counters, readable from any thread.
   uint64_t partialFrames() const { return partial_.load(std::memory_order_relaxed); }  // left with a camera missing
-  uint64_t lateImages() const { return late_.load(std::memory_order_relaxed); }  // came after their frame left
+  uint64_t lateImages() const { return late_.load(std::memory_order_relaxed); }        // came after their frame left
   uint64_t duplicateImages() const { return duplicate_.load(std::memory_order_relaxed); }
   uint32_t pendingFrames() const { return pending_count_.load(std::memory_order_relaxed); }
   int cameras() const { return cameras_; }

@@ -56,7 +56,7 @@ class YamlFields {
   // File permissions: an octal string ("0640") or an integer written in octal (0640 parses as 640).
   unsigned permissions(const char* key, unsigned fallback) const;
 
-  YamlFields child(const char* key) const;     // an absent child is an empty map
+  YamlFields child(const char* key) const;  // an absent child is an empty map
   YAML::Node node(const char* key) const { return node_[key]; }
   std::string keyName(const char* key) const { return path_.empty() ? key : path_ + "." + key; }
   const std::string& file() const { return file_; }

@@ -47,8 +47,11 @@ class DropOldestRing {
   // `init` is called once per slot (e.g. to size its image buffers).
   template <typename Init>
   DropOldestRing(uint32_t capacity, Init init)
-      : capacity_(capacity), pool_size_(capacity + 2), pool_(new T[capacity + 2]),
-        queue_(new std::atomic<uint32_t>[capacity]), free_(capacity + 2) {
+      : capacity_(capacity),
+        pool_size_(capacity + 2),
+        pool_(new T[capacity + 2]),
+        queue_(new std::atomic<uint32_t>[capacity]),
+        free_(capacity + 2) {
     if (capacity == 0) throw std::invalid_argument("DropOldestRing: capacity must be at least 1");
     for (uint32_t i = 0; i < pool_size_; ++i) {
       init(pool_[i]);
@@ -115,9 +118,7 @@ class DropOldestRing {
   }
 
   // Either side.
-  uint64_t size() const {
-    return head_.load(std::memory_order_acquire) - tail_.load(std::memory_order_acquire);
-  }
+  uint64_t size() const { return head_.load(std::memory_order_acquire) - tail_.load(std::memory_order_acquire); }
   uint64_t published() const { return head_.load(std::memory_order_relaxed); }
   uint64_t dropped() const { return dropped_.load(std::memory_order_relaxed); }
 

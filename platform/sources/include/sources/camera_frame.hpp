@@ -10,9 +10,9 @@ namespace mcslam::platform {
 
 struct CameraFrame {
   Image image;
-  Timestamp capture_ns = 0;      // time base of the trajectory (dataset stamps, or host CLOCK_REALTIME)
-  uint64_t trigger_index = 0;    // which trigger (or frame number) produced it
-  int64_t trigger_mono_ns = 0;   // CLOCK_MONOTONIC of the trigger (or of the arrival when free-running)
+  Timestamp capture_ns = 0;     // time base of the trajectory (dataset stamps, or host CLOCK_REALTIME)
+  uint64_t trigger_index = 0;   // which trigger (or frame number) produced it
+  int64_t trigger_mono_ns = 0;  // CLOCK_MONOTONIC of the trigger (or of the arrival when free-running)
 };
 
 }  // namespace mcslam::platform

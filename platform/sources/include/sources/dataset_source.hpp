@@ -46,7 +46,7 @@ class DatasetSource final : public FrameSource, private TriggerOutput {
   std::vector<std::vector<bool>> present_;
   std::string load_error_;
   SourceLinks links_;
-  CameraRings* rings_ = nullptr;  // links_.rings
+  CameraRings* rings_ = nullptr;        // links_.rings
   std::atomic<uint64_t> triggered_{0};  // software triggers received
   Doorbell trigger_bell_;
   std::atomic<bool> stop_{false};

@@ -34,9 +34,9 @@ struct DatasetSourceConfig {
   ReplayRate rate = ReplayRate::Recorded;
   double speed = 1.0;
   AtEnd at_end = AtEnd::Exit;
-  bool preload = false;           // decode every image at start (replay then allocates nothing)
+  bool preload = false;  // decode every image at start (replay then allocates nothing)
   uint32_t max_preload_frames = 2000;
-  std::vector<int> cameras;       // calibration indices to use (empty = all)
+  std::vector<int> cameras;  // calibration indices to use (empty = all)
 };
 
 // Live rendering with the simulator (mcslam_sim): frames are rendered as they are due.
@@ -49,9 +49,9 @@ struct SimSourceConfig {
   uint64_t seed = 1;
   SimPace pace = SimPace::Fastest;
   AtEnd at_end = AtEnd::Loop;
-  bool anti_aliasing = true;          // false: one ray per pixel, cheaper
-  int render_threads = 0;             // 0: one per core
-  std::vector<int> cameras;           // rig indices to render (empty = all)
+  bool anti_aliasing = true;  // false: one ray per pixel, cheaper
+  int render_threads = 0;     // 0: one per core
+  std::vector<int> cameras;   // rig indices to render (empty = all)
 };
 
 // What a source needs besides its own section.

@@ -10,8 +10,8 @@
 namespace mcslam::backend {
 
 struct ExtrinsicPriorSigmas {
-  double translation = 0.01;                // metres
-  double rotation = 1.0 * M_PI / 180.0;     // radians
+  double translation = 0.01;             // metres
+  double rotation = 1.0 * M_PI / 180.0;  // radians
 };
 
 // Residual at T; Jacobian (optional) evaluated at T_jac (the first estimate when the extrinsic is

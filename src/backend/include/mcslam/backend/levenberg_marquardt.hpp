@@ -34,7 +34,7 @@ struct DampingPolicy {
   double accept_factor = 0.2;
   double accept_divisor = 1.0;
   double reject_factor = 10.0;
-  double min = 1e-9;                                   // lambda after a taken step stays above
+  double min = 1e-9;                                     // lambda after a taken step stays above
   double max = std::numeric_limits<double>::infinity();  // no trial with lambda above: the loop stops
   // Trust region.
   double min_gain = 1e-3;

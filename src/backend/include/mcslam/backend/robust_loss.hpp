@@ -19,8 +19,7 @@ struct RobustLoss {
     rho = s;
     weight = 1.0;
     switch (kind) {
-      case LossKind::Trivial:
-        return;
+      case LossKind::Trivial: return;
       case LossKind::Huber:
         if (s <= a2) {
           rho = s;

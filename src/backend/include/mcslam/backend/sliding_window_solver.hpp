@@ -37,15 +37,15 @@ struct WindowCapacity {
 };
 
 struct SolverOptions {
-  RobustLoss loss;                       // Huber by default; threshold in units of sigma
-  double outlier_chi2 = 5.991;           // |r|^2 above this after a solve marks an outlier (2 dof, 95%)
+  RobustLoss loss;              // Huber by default; threshold in units of sigma
+  double outlier_chi2 = 5.991;  // |r|^2 above this after a solve marks an outlier (2 dof, 95%)
 
   bool refine_extrinsics = false;        // turn on for rigs whose calibration was chained
   int reference_camera = 0;              // its extrinsic stays fixed: it anchors the body frame
   ExtrinsicPriorSigmas extrinsic_prior;  // the calibration's uncertainty
   bool first_estimate_jacobians = true;  // for the extrinsics linked to the marginalization prior
 
-  int gauge_fixed_oldest = 1;            // oldest keyframes held fixed (2 for a monocular rig: scale)
+  int gauge_fixed_oldest = 1;  // oldest keyframes held fixed (2 for a monocular rig: scale)
   // The window's unit held instead by all its keyframes: the summed distances from the oldest keyframe of
   // those between it and the newest stay as the solve found them (a stiff residual). Two fixed keyframes tie
   // the unit to one pair, which can be 10 cm apart (keyframes at every frame where tracking thins): a 1 cm
@@ -58,9 +58,9 @@ struct SolverOptions {
 
   // Levenberg-Marquardt (the trust-region form Ceres uses).
   double initial_trust_radius = 1e4;
-  double function_tolerance = 1e-6;      // stop when |d cost| / cost falls below
-  double gradient_tolerance = 1e-10;     // stop when max |gradient| falls below
-  double parameter_tolerance = 1e-8;     // stop when |dx| <= tol * (|x| + tol)
+  double function_tolerance = 1e-6;   // stop when |d cost| / cost falls below
+  double gradient_tolerance = 1e-10;  // stop when max |gradient| falls below
+  double parameter_tolerance = 1e-8;  // stop when |dx| <= tol * (|x| + tol)
 };
 
 enum class Status {
@@ -83,17 +83,17 @@ struct ObservationKey {
 };
 
 struct SolveSummary {
-  int iterations = 0;            // linear solves (accepted or not)
+  int iterations = 0;  // linear solves (accepted or not)
   int accepted_steps = 0;
-  double initial_cost = 0;       // 0.5 * sum rho(|r|^2) + priors
+  double initial_cost = 0;  // 0.5 * sum rho(|r|^2) + priors
   double final_cost = 0;
-  bool converged = false;        // a tolerance was met (false: iteration budget or failure)
-  bool failed = false;           // no valid linearization (nothing to optimize or bad input)
-  int symbolic_analyses = 0;     // CHOLMOD analyses run by this solve (0 when the structure held)
-  int landmarks_used = 0;        // landmarks that entered the solve
-  int landmarks_skipped = 0;     // too few observations or no parallax
+  bool converged = false;     // a tolerance was met (false: iteration budget or failure)
+  bool failed = false;        // no valid linearization (nothing to optimize or bad input)
+  int symbolic_analyses = 0;  // CHOLMOD analyses run by this solve (0 when the structure held)
+  int landmarks_used = 0;     // landmarks that entered the solve
+  int landmarks_skipped = 0;  // too few observations or no parallax
   int residuals_used = 0;
-  int outliers = 0;              // size of outliers()
+  int outliers = 0;  // size of outliers()
 };
 
 class SlidingWindowSolver {

@@ -63,8 +63,8 @@ class CameraModel {
   double fx_ = 1, fy_ = 1, cx_ = 0, cy_ = 0;
   Distortion distortion_ = Distortion::None;
   std::array<double, 4> k_{0, 0, 0, 0};
-  double max_angle_ = 0;     // radians from the optical axis
-  double max_radius2_ = 0;   // radtan/none: largest squared radius on the normalised plane
+  double max_angle_ = 0;    // radians from the optical axis
+  double max_radius2_ = 0;  // radtan/none: largest squared radius on the normalised plane
 };
 
 }  // namespace mcslam

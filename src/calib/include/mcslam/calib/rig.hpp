@@ -20,10 +20,10 @@ struct PluckerRay {
 };
 
 struct RigCamera {
-  std::string name;         // "cam0", ...
+  std::string name;  // "cam0", ...
   CameraModel model;
-  SE3 T_b_c;                // camera -> body
-  int source_index = 0;     // index in the calibration file (stays stable when a subset is taken)
+  SE3 T_b_c;             // camera -> body
+  int source_index = 0;  // index in the calibration file (stays stable when a subset is taken)
 };
 
 class Rig {

@@ -15,7 +15,8 @@ inline Timestamp fromSeconds(double s) { return static_cast<Timestamp>(s * 1e9 +
 // Exact decimal seconds, as files write time stamps ("12.300000001", "-0.000000005").
 inline std::string toSecondsString(Timestamp ns) {
   char buf[48];
-  const unsigned long long a = ns < 0 ? 0ULL - static_cast<unsigned long long>(ns) : static_cast<unsigned long long>(ns);
+  const unsigned long long a =
+      ns < 0 ? 0ULL - static_cast<unsigned long long>(ns) : static_cast<unsigned long long>(ns);
   std::snprintf(buf, sizeof(buf), "%s%llu.%09llu", ns < 0 ? "-" : "", a / 1000000000ULL, a % 1000000000ULL);
   return buf;
 }

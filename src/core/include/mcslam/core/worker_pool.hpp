@@ -64,12 +64,12 @@ class WorkerPool {
 
   std::mutex mutex_;
   std::condition_variable wake_, done_;
-  PoolJob* job_ = nullptr;     // the current batch (written under mutex_ before generation_ moves)
+  PoolJob* job_ = nullptr;  // the current batch (written under mutex_ before generation_ moves)
   int tasks_ = 0;
-  std::atomic<int> next_{0};   // next task to hand out
-  int active_ = 0;             // workers not done with the current batch (guarded by mutex_)
-  uint64_t generation_ = 0;    // one per batch (guarded by mutex_)
-  bool stopping_ = false;      // guarded by mutex_
+  std::atomic<int> next_{0};          // next task to hand out
+  int active_ = 0;                    // workers not done with the current batch (guarded by mutex_)
+  uint64_t generation_ = 0;           // one per batch (guarded by mutex_)
+  bool stopping_ = false;             // guarded by mutex_
   std::vector<std::thread> workers_;  // last: started once the members above exist
 };
 

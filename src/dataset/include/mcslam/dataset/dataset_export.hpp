@@ -29,9 +29,9 @@ DatasetLayoutKind parseDatasetLayout(const std::string& name);
 const char* datasetLayoutName(DatasetLayoutKind kind);
 
 struct DatasetExportReport {
-  std::size_t frames_written = 0;   // rig frames written (KITTI) or rig frames with at least one image written
+  std::size_t frames_written = 0;  // rig frames written (KITTI) or rig frames with at least one image written
   std::size_t images_written = 0;
-  std::size_t frames_skipped = 0;   // KITTI: rig frames missing a camera
+  std::size_t frames_skipped = 0;  // KITTI: rig frames missing a camera
   std::size_t ground_truth_poses = 0;
   std::vector<std::string> warnings;  // e.g. ground truth not written because frames lack a pose
 };

@@ -17,8 +17,8 @@ namespace mcslam {
 
 struct EvalOptions {
   AlignMode align = AlignMode::SE3;
-  double max_diff_s = 0.01;   // largest stamp difference of an associated pair (evo's default)
-  double t_offset_s = 0.0;    // added to the estimate's stamps before association
+  double max_diff_s = 0.01;  // largest stamp difference of an associated pair (evo's default)
+  double t_offset_s = 0.0;   // added to the estimate's stamps before association
   // Names for messages (usually the file paths).
   std::string reference_name = "reference";
   std::string estimate_name = "estimate";
@@ -26,9 +26,9 @@ struct EvalOptions {
 
 // The associated, aligned pair both metrics work on.
 struct AlignedTrajectories {
-  Trajectory ref;       // associated reference poses
-  Trajectory est;       // associated estimate poses, aligned onto the reference
-  Similarity alignment; // what was applied to the estimate (identity for AlignMode::None)
+  Trajectory ref;              // associated reference poses
+  Trajectory est;              // associated estimate poses, aligned onto the reference
+  Similarity alignment;        // what was applied to the estimate (identity for AlignMode::None)
   double ref_path_length = 0;  // of the associated reference, metres
 };
 
@@ -39,7 +39,7 @@ struct ApeResult {
   AlignedTrajectories data;
   std::vector<double> errors;  // metres, one per associated pose
   ErrorStats stats;
-  double rmse_percent = 0;     // rmse / ref_path_length * 100 (0 when the path has no length)
+  double rmse_percent = 0;  // rmse / ref_path_length * 100 (0 when the path has no length)
 };
 
 ApeResult computeApe(const Trajectory& ref, const Trajectory& est, const EvalOptions& options);
@@ -48,7 +48,7 @@ enum class DeltaUnit { Frames, Meters };
 
 struct RpeOptions {
   EvalOptions eval;
-  double delta = 1;                   // frames (a whole number) or metres of travelled path
+  double delta = 1;  // frames (a whole number) or metres of travelled path
   DeltaUnit unit = DeltaUnit::Frames;
   bool all_pairs = false;             // every start index instead of consecutive, non-overlapping pairs
   bool pairs_from_reference = false;  // evo pairs on the estimate's path unless asked otherwise
@@ -65,11 +65,11 @@ IndexPairs rpePairs(const Trajectory& traj, double delta, DeltaUnit unit, bool a
 struct RpeResult {
   AlignedTrajectories data;
   IndexPairs pairs;
-  std::vector<double> translation_errors;  // metres, one per pair
-  std::vector<double> rotation_errors_deg; // degrees, one per pair
+  std::vector<double> translation_errors;   // metres, one per pair
+  std::vector<double> rotation_errors_deg;  // degrees, one per pair
   ErrorStats translation;
   ErrorStats rotation_deg;
-  double rmse_percent = 0;                 // translation rmse / ref_path_length * 100
+  double rmse_percent = 0;  // translation rmse / ref_path_length * 100
 };
 
 // Throws InputError when the delta gives no pair.

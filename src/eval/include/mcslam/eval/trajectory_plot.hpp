@@ -10,11 +10,11 @@
 namespace mcslam {
 
 struct TrajectoryPlot {
-  std::string title;                 // first line, e.g. "APE: rmse 0.0081 m (0.43 % of 18.9 m)"
-  std::string subtitle;              // second line, smaller (settings, file names)
-  std::vector<Vec3> reference;       // drawn dashed grey, thin, over the estimate
-  std::vector<Vec3> estimate;        // drawn coloured by estimate_error
-  std::vector<double> estimate_error;  // one per estimate point (NaN: no value, drawn grey)
+  std::string title;                      // first line, e.g. "APE: rmse 0.0081 m (0.43 % of 18.9 m)"
+  std::string subtitle;                   // second line, smaller (settings, file names)
+  std::vector<Vec3> reference;            // drawn dashed grey, thin, over the estimate
+  std::vector<Vec3> estimate;             // drawn coloured by estimate_error
+  std::vector<double> estimate_error;     // one per estimate point (NaN: no value, drawn grey)
   std::string error_label = "error [m]";  // colour bar caption
   std::string reference_label = "reference";
   std::string estimate_label = "estimate";

@@ -16,9 +16,9 @@
 namespace mcslam {
 
 struct EpipolarAlignmentOptions {
-  int half_size = 3;            // patch of (2 half_size + 1)^2 samples, spaced by the reference octave's scale
+  int half_size = 3;  // patch of (2 half_size + 1)^2 samples, spaced by the reference octave's scale
   int max_iterations = 8;
-  double converged_px = 0.01;   // stop when a step is below this
+  double converged_px = 0.01;  // stop when a step is below this
   // Patches that correlate less than this after alignment show different surfaces (a wrong match, or a depth
   // edge where the two views see different backgrounds).
   double min_zncc = 0.85;
@@ -61,7 +61,7 @@ struct AlignmentTemplate {
   alignas(16) float value[kMaxPadded];
   alignas(16) float dx[kMaxPadded];
   alignas(16) float dy[kMaxPadded];
-  Vec2 axis = Vec2::UnitX();           // the dominant gradient's direction (main axis of the structure tensor)
+  Vec2 axis = Vec2::UnitX();  // the dominant gradient's direction (main axis of the structure tensor)
 };
 
 // Where in the template the alignment's information lies, relative to its centre (reference pixels): the

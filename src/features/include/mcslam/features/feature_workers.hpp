@@ -84,15 +84,15 @@ class FeatureWorkers {
   void processCamera(int camera, OrbExtractor& extractor);
   int takeReadyTask();  // -1 when no untaken task has both cameras done (caller holds mutex_)
 
-  std::vector<ImageSize> max_sizes_;     // per camera: an image larger than this is refused
+  std::vector<ImageSize> max_sizes_;      // per camera: an image larger than this is refused
   std::vector<OrbExtractor> extractors_;  // per thread
 
-  std::mutex mutex_;                  // the follow-up's bookkeeping during a frame
+  std::mutex mutex_;  // the follow-up's bookkeeping during a frame
   std::condition_variable camera_done_;
   ExtractionFollowUp* follow_up_ = nullptr;
-  int tasks_ = 0;                  // of the follow-up, per frame
-  std::vector<uint8_t> done_;      // per camera, this frame (guarded by mutex_)
-  std::vector<uint8_t> taken_;     // per task, this frame (guarded by mutex_)
+  int tasks_ = 0;               // of the follow-up, per frame
+  std::vector<uint8_t> done_;   // per camera, this frame (guarded by mutex_)
+  std::vector<uint8_t> taken_;  // per task, this frame (guarded by mutex_)
 
   // The current frame's arguments, valid during extract().
   const ImageView* images_ = nullptr;

@@ -19,13 +19,13 @@ struct KeypointRef {
 };
 
 struct MultiViewFeature {
-  int32_t first = 0;          // first of its observations in FrameFeatures::mv_refs
-  int16_t size = 0;           // number of observations (cameras)
-  bool has_point = false;     // triangulated: in front of every camera, consistent with every keypoint
-  bool metric = false;        // and its depth is certain (relative sigma below the configured bound)
-  Vec3 p_b = Vec3::Zero();    // point in the body frame, when has_point
+  int32_t first = 0;               // first of its observations in FrameFeatures::mv_refs
+  int16_t size = 0;                // number of observations (cameras)
+  bool has_point = false;          // triangulated: in front of every camera, consistent with every keypoint
+  bool metric = false;             // and its depth is certain (relative sigma below the configured bound)
+  Vec3 p_b = Vec3::Zero();         // point in the body frame, when has_point
   float relative_depth_sigma = 0;  // standard deviation of the depth over the depth
-  Descriptor descriptor{};    // representative (medoid) descriptor
+  Descriptor descriptor{};         // representative (medoid) descriptor
 };
 
 class FrameFeatures {
@@ -44,15 +44,15 @@ class FrameFeatures {
   int monoCount() const;
 
   Timestamp t = 0;
-  std::vector<uint8_t> present;               // per camera: the image was there
-  std::vector<FeatureSet> sets;               // per camera keypoints and descriptors
-  std::vector<std::vector<Vec3>> bearings;    // per camera per keypoint: unit bearing (camera frame)
-  std::vector<std::vector<uint8_t>> valid;    // per camera per keypoint: the bearing could be computed
-  std::vector<std::vector<int32_t>> mv_of;    // per camera per keypoint: multi-view feature index or -1
+  std::vector<uint8_t> present;             // per camera: the image was there
+  std::vector<FeatureSet> sets;             // per camera keypoints and descriptors
+  std::vector<std::vector<Vec3>> bearings;  // per camera per keypoint: unit bearing (camera frame)
+  std::vector<std::vector<uint8_t>> valid;  // per camera per keypoint: the bearing could be computed
+  std::vector<std::vector<int32_t>> mv_of;  // per camera per keypoint: multi-view feature index or -1
 
-  std::vector<MultiViewFeature> mv;           // capacity: cameras * max_features / 2
+  std::vector<MultiViewFeature> mv;  // capacity: cameras * max_features / 2
   int mv_count = 0;
-  std::vector<KeypointRef> mv_refs;           // observations of the multi-view features
+  std::vector<KeypointRef> mv_refs;  // observations of the multi-view features
   int mv_ref_count = 0;
 
  private:

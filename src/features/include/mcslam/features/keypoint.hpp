@@ -8,10 +8,10 @@
 namespace mcslam {
 
 struct Keypoint {
-  float x = 0, y = 0;    // level-0 pixel coordinates (centre of pixel (0,0) at (0,0))
-  float angle = 0;       // orientation, radians, from the intensity centroid
-  float response = 0;    // corner score (higher is stronger)
-  int8_t octave = 0;     // pyramid level it was detected at
+  float x = 0, y = 0;  // level-0 pixel coordinates (centre of pixel (0,0) at (0,0))
+  float angle = 0;     // orientation, radians, from the intensity centroid
+  float response = 0;  // corner score (higher is stronger)
+  int8_t octave = 0;   // pyramid level it was detected at
 };
 
 using Descriptor = std::array<uint64_t, 4>;  // 256 bits

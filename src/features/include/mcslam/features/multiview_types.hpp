@@ -9,12 +9,12 @@
 namespace mcslam {
 
 struct MultiViewOptions {
-  int max_hamming = 60;             // accept a match only below this descriptor distance (of 256 bits)
-  float ratio = 0.8f;               // best / second best among epipolar-consistent candidates
-  double epipolar_px = 2.0;         // gate, in pixels at octave 0 (scaled by the keypoint's octave sigma)
-  float octave_scale = 1.2f;        // pyramid scale factor: sigma = scale^octave
-  int max_octave_difference = 2;    // scale consistency between the two keypoints
-  double duplicate_px = 3.0;        // candidates this close to the best (x octave sigma) are the same corner
+  int max_hamming = 60;                // accept a match only below this descriptor distance (of 256 bits)
+  float ratio = 0.8f;                  // best / second best among epipolar-consistent candidates
+  double epipolar_px = 2.0;            // gate, in pixels at octave 0 (scaled by the keypoint's octave sigma)
+  float octave_scale = 1.2f;           // pyramid scale factor: sigma = scale^octave
+  int max_octave_difference = 2;       // scale consistency between the two keypoints
+  double duplicate_px = 3.0;           // candidates this close to the best (x octave sigma) are the same corner
   TriangulationOptions triangulation;  // max_relative_depth_sigma decides which points are metric
   // A two-view match has no geometric check of its depth (a wrong partner along the epipolar curve is just
   // another depth). It is dropped when a present camera nearer to one of its two cameras than they are to
@@ -40,13 +40,13 @@ struct MultiViewOptions {
 };
 
 struct MultiViewStats {
-  int pair_matches = 0;     // accepted pairwise matches
-  int tracks = 0;           // multi-view features
+  int pair_matches = 0;  // accepted pairwise matches
+  int tracks = 0;        // multi-view features
   int tracks_with_point = 0;
-  int metric_tracks = 0;    // with a depth certain to the configured bound
-  int dropped = 0;          // tracks rejected by geometry
-  int aligned = 0;          // partner keypoints aligned to their reference to subpixel precision
-  int disagreeing = 0;      // partner keypoints whose patch did not match the reference's: removed from the track
+  int metric_tracks = 0;  // with a depth certain to the configured bound
+  int dropped = 0;        // tracks rejected by geometry
+  int aligned = 0;        // partner keypoints aligned to their reference to subpixel precision
+  int disagreeing = 0;    // partner keypoints whose patch did not match the reference's: removed from the track
 };
 
 // A mutual best match between keypoint kp_a of camera cam_a and keypoint kp_b of camera cam_b.

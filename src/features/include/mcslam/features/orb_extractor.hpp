@@ -13,17 +13,17 @@
 namespace mcslam {
 
 struct OrbOptions {
-  int max_features = 1000;      // features per image, shared among the levels in proportion to 1/scale^level
-  int levels = 8;               // pyramid levels
-  float scale_factor = 1.2f;    // size ratio between consecutive levels
-  int fast_threshold = 20;      // FAST intensity threshold
-  int min_fast_threshold = 7;   // used instead in grid cells where fast_threshold finds no corner
-  int fallback_cell = 32;       // size of those cells, level pixels (ORB-SLAM uses 30)
+  int max_features = 1000;     // features per image, shared among the levels in proportion to 1/scale^level
+  int levels = 8;              // pyramid levels
+  float scale_factor = 1.2f;   // size ratio between consecutive levels
+  int fast_threshold = 20;     // FAST intensity threshold
+  int min_fast_threshold = 7;  // used instead in grid cells where fast_threshold finds no corner
+  int fallback_cell = 32;      // size of those cells, level pixels (ORB-SLAM uses 30)
   // Features of a level keep at least spacing_ratio * sqrt(area / budget) pixels apart (the spacing of
   // an even spread), strongest first; passes at half that and at none fill the budget. 0: strongest only.
   float spacing_ratio = 0.25f;
-  int edge_margin = 16;         // pixels kept free at every border of each level; at least the patch radius (15)
-  bool use_simd = true;         // false forces the portable FAST kernel (tests compare the two)
+  int edge_margin = 16;  // pixels kept free at every border of each level; at least the patch radius (15)
+  bool use_simd = true;  // false forces the portable FAST kernel (tests compare the two)
 };
 
 // Per-level scale factors: scale[l] = scale_factor^l, sigma2[l] = scale[l]^2 (keypoint position
@@ -34,9 +34,9 @@ struct OrbLevelScales {
 OrbLevelScales orbLevelScales(const OrbOptions& options);
 
 enum class OrbStatus {
-  kOk,               // features written (possibly none: empty, tiny or textureless image)
-  kImageTooLarge,    // wider or taller than the size given at construction; no features
-  kOutputTooSmall,   // out.capacity() < max_features; no features
+  kOk,              // features written (possibly none: empty, tiny or textureless image)
+  kImageTooLarge,   // wider or taller than the size given at construction; no features
+  kOutputTooSmall,  // out.capacity() < max_features; no features
 };
 
 class OrbExtractor {

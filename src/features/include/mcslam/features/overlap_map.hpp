@@ -16,12 +16,12 @@
 namespace mcslam {
 
 struct OverlapOptions {
-  int cell_size_px = 32;      // grid cell edge, pixels
-  double min_depth = 0.3;     // metres: the nearest scene point a match may have
-  double max_depth = 100.0;   // metres: the farthest (use a large value outdoors)
-  int depth_samples = 48;     // samples along each ray, uniform in inverse depth
-  int samples_per_cell = 3;   // per cell edge: 3 -> 3x3 pixels per cell (corners, edges, centre)
-  int dilate_cells = 1;       // grow each candidate set by this many cells (keypoint and calibration error)
+  int cell_size_px = 32;     // grid cell edge, pixels
+  double min_depth = 0.3;    // metres: the nearest scene point a match may have
+  double max_depth = 100.0;  // metres: the farthest (use a large value outdoors)
+  int depth_samples = 48;    // samples along each ray, uniform in inverse depth
+  int samples_per_cell = 3;  // per cell edge: 3 -> 3x3 pixels per cell (corners, edges, centre)
+  int dilate_cells = 1;      // grow each candidate set by this many cells (keypoint and calibration error)
 };
 
 // A grid of square cells over one image.

@@ -48,27 +48,27 @@ class PairMatcher {
   // the candidate cells of the current cell of camera i marked with a stamp, and the mutual-best bookkeeping.
   struct PairScratch {
     PairScratch(int capacity, int max_cells);
-    std::vector<float> plane_angle;       // per keypoint of camera j
-    std::vector<int32_t> sorted_b;        // keypoints of j away from the epipole, by plane angle
+    std::vector<float> plane_angle;  // per keypoint of camera j
+    std::vector<int32_t> sorted_b;   // keypoints of j away from the epipole, by plane angle
     std::vector<float> sorted_angle;
     std::vector<Candidate> sorted_candidates;
     std::vector<int32_t> near_epipole_b;  // keypoints of j close to the baseline direction: checked one by one
     std::vector<uint32_t> cell_stamp;     // per cell of camera j
     uint32_t stamp = 0;
-    std::vector<int32_t> best_for_b;      // per keypoint of camera j: best keypoint of camera i
+    std::vector<int32_t> best_for_b;  // per keypoint of camera j: best keypoint of camera i
     std::vector<int16_t> best_dist_for_b;
     std::vector<int16_t> second_dist_for_b;  // ignoring copies of the best at other octaves
-    std::vector<int32_t> candidate_b;     // epipolar-consistent candidates of the current keypoint
+    std::vector<int32_t> candidate_b;        // epipolar-consistent candidates of the current keypoint
     std::vector<int16_t> candidate_dist;
   };
   // The epipolar geometry of one pair (i, j) and camera j's keypoints arranged for the band scan.
   struct PairGeometry {
-    Vec3 e, u, v;                  // baseline direction and two axes normal to it (body frame)
-    double gate[kMaxOctaves];      // sine of the largest angle to the epipolar plane, per octave of the keypoint in j
+    Vec3 e, u, v;              // baseline direction and two axes normal to it (body frame)
+    double gate[kMaxOctaves];  // sine of the largest angle to the epipolar plane, per octave of the keypoint in j
     float gate_f[kMaxOctaves];
-    double window[kMaxOctaves];    // half-width of the plane-angle window, per octave of the keypoint in j
+    double window[kMaxOctaves];         // half-width of the plane-angle window, per octave of the keypoint in j
     int octave_start[kMaxOctaves + 1];  // sorted candidates of each octave
-    int near = 0;                  // keypoints of j near the epipole
+    int near = 0;                       // keypoints of j near the epipole
   };
   void bucketKeypoints(const FrameFeatures& f, int camera);
   int matchCameras(const Rig& rig, const FrameFeatures& f, int i, int j, PairScratch& s, PairMatch* out) const;
@@ -80,15 +80,15 @@ class PairMatcher {
   const OverlapMap& overlap_;
   MultiViewOptions options_;
   int capacity_;
-  double same_px2_[kMaxOctaves] = {};  // (duplicate_px * sigma(octave))^2
+  double same_px2_[kMaxOctaves] = {};          // (duplicate_px * sigma(octave))^2
   OctaveScales sigma_{options_.octave_scale};  // octave_scale^octave
 
   // Keypoints bucketed by cell, per camera (counting sort).
   std::vector<std::vector<int32_t>> cell_start_;  // cells + 1
   std::vector<std::vector<int32_t>> cell_items_;
-  std::vector<std::vector<int32_t>> cell_of_;     // per keypoint
-  std::vector<std::vector<Vec3>> dir_b_;          // per keypoint: bearing rotated into the body frame
-  std::vector<PairScratch> scratch_;              // per thread
+  std::vector<std::vector<int32_t>> cell_of_;  // per keypoint
+  std::vector<std::vector<Vec3>> dir_b_;       // per keypoint: bearing rotated into the body frame
+  std::vector<PairScratch> scratch_;           // per thread
 
   // Pairwise matches: pair p's in its slot of `capacity_` from p * capacity_, gathered to the front in pair order.
   std::vector<PairMatch> matches_;

@@ -93,7 +93,7 @@ class TrackBuilder {
   std::vector<int32_t> distance_count_;  // counting sort buckets (257)
   std::vector<int32_t> component_of_root_;
   std::vector<int32_t> component_size_;
-  std::vector<int32_t> members_;         // nodes grouped by component
+  std::vector<int32_t> members_;  // nodes grouped by component
   // The tracks of the frame: members_[first, first + size) each, the reference first and the partners that
   // disagree moved past the size once aligned; per track the alignment's counts, per member of members_ its
   // observation (after the alignment; scratch of the emission without it).
@@ -104,7 +104,7 @@ class TrackBuilder {
   std::vector<int16_t> track_disagreeing_;
   std::vector<Member> aligned_obs_;
   std::vector<TrackSolution> track_solution_;  // per track, when aligned: solved on the alignment's threads
-  bool aligned_frame_ = false;  // this frame's tracks are aligned
+  bool aligned_frame_ = false;                 // this frame's tracks are aligned
 };
 
 }  // namespace mcslam

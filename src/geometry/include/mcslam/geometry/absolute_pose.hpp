@@ -10,11 +10,11 @@ namespace mcslam {
 
 // A keypoint of the current rig frame matched to a map point.
 struct PoseObservation {
-  int camera = 0;          // index of the camera in the rig
+  int camera = 0;             // index of the camera in the rig
   Vec2 pixel = Vec2::Zero();  // measured keypoint, pixels
-  BodyRay ray;             // its ray in the body frame: bodyRay(rig, camera, unproject(pixel)), consistent with pixel
+  BodyRay ray;  // its ray in the body frame: bodyRay(rig, camera, unproject(pixel)), consistent with pixel
   Vec3 point_w = Vec3::Zero();  // the matched map point, world frame
-  double sigma_px = 1.0;   // standard deviation of the keypoint (e.g. its pyramid scale), pixels
+  double sigma_px = 1.0;        // standard deviation of the keypoint (e.g. its pyramid scale), pixels
 };
 
 // The observation of keypoint `pixel` of camera `cam` (unit bearing_c = its unprojection, when the

@@ -73,7 +73,7 @@ class AbsolutePoseRansac {
   AbsolutePoseRansacOptions options_;
   PoseRefiner refiner_;
   RansacRandom random_;
-  std::vector<SE3> T_c_w_;        // per camera, for the hypothesis being scored
+  std::vector<SE3> T_c_w_;  // per camera, for the hypothesis being scored
   std::vector<uint8_t> inliers_;
 };
 

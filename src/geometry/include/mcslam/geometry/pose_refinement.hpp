@@ -18,16 +18,16 @@
 namespace mcslam {
 
 struct PoseRefinementOptions {
-  int rounds = 4;                  // outlier-rejection rounds (ORB-SLAM: 4 x 10 iterations)
+  int rounds = 4;  // outlier-rejection rounds (ORB-SLAM: 4 x 10 iterations)
   int iterations_per_round = 10;
-  int robust_rounds = 2;           // rounds with the Huber loss; the later ones use plain squares
-  double chi2_threshold = 5.991;   // inlier when (error / sigma)^2 below: chi-square, 2 dof, 95%
-  double huber_threshold = 2.4477; // whitened error (sigmas) where the Huber loss turns linear: sqrt(5.991)
+  int robust_rounds = 2;            // rounds with the Huber loss; the later ones use plain squares
+  double chi2_threshold = 5.991;    // inlier when (error / sigma)^2 below: chi-square, 2 dof, 95%
+  double huber_threshold = 2.4477;  // whitened error (sigmas) where the Huber loss turns linear: sqrt(5.991)
   // Errors beyond this many sigmas count as a constant, like a point that does not project at all:
   // a gross outlier of a wide-angle lens (hundreds of pixels) then neither dominates the Huber sum
   // nor gains the optimizer anything by being pushed out of the lens's domain.
   double gross_error_sigmas = 100.0;
-  int min_inliers = 6;             // fewer: the refinement fails
+  int min_inliers = 6;  // fewer: the refinement fails
 };
 
 struct PoseRefinementResult {
@@ -39,7 +39,7 @@ struct PoseRefinementResult {
   // Information of the pose, sum of J^T J / sigma^2 over the inliers at T_w_b (right perturbation,
   // [rho; phi]). Its smallest eigenvalue tells how well the weakest direction is constrained.
   Mat6 information = Mat6::Zero();
-  int iterations = 0;    // Levenberg-Marquardt steps tried, all rounds
+  int iterations = 0;  // Levenberg-Marquardt steps tried, all rounds
   // One byte per observation, 1 = inlier at T_w_b. Points into the refiner: valid until its next call.
   std::span<const uint8_t> inlier_mask;
 };

@@ -41,10 +41,10 @@ struct RelativePoseOptions {
   // Standard deviation of a bearing (about pixel sigma / focal length; 1 px at f = 500 here). It sets
   // the inlier threshold and the noise of the observability check.
   double bearing_sigma_rad = 0.002;
-  double inlier_sigmas = 3.0;        // inlier when the (Sampson) angle error is below this many sigmas
-  int max_iterations = 2000;         // RANSAC samples cap (17 points per sample in the generalized case)
+  double inlier_sigmas = 3.0;  // inlier when the (Sampson) angle error is below this many sigmas
+  int max_iterations = 2000;   // RANSAC samples cap (17 points per sample in the generalized case)
   double confidence = 0.99;
-  uint64_t seed = 1;                 // RANSAC sampler seed (deterministic)
+  uint64_t seed = 1;  // RANSAC sampler seed (deterministic)
   int min_inliers = 30;
   double max_relative_scale_sigma = 0.03;  // generalized: sigma(|t|) / |t| above this -> ScaleUnobservable
   double max_direction_sigma_rad = 0.05;   // sigma of the translation direction above this -> DirectionUnobservable

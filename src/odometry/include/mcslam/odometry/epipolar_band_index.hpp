@@ -5,8 +5,8 @@
 // centre, so the partners of a ray are the bearings of the other camera whose half-plane angle is within a
 // small window of the ray's (the window widens near the baseline direction, where bearings are kept apart
 // and checked one by one). Bearings are binned by octave and angle with a counting sort: O(n) per pair.
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -16,7 +16,7 @@ namespace mcslam {
 
 class EpipolarBandIndex {
  public:
-  static constexpr int kBins = 256;            // per octave, over the full turn
+  static constexpr int kBins = 256;              // per octave, over the full turn
   static constexpr double kNearAxisSine = 0.05;  // bearings within ~3 degrees of the baseline: checked one by one
 
   EpipolarBandIndex(int capacity, int octaves);
@@ -52,20 +52,19 @@ class EpipolarBandIndex {
   std::vector<int32_t> added_key_;
   int added_count_ = 0;
   std::vector<Entry> sorted_;
-  std::vector<int32_t> start_;    // octaves * kBins + 1
-  std::vector<float> min_sine_;   // per octave: smallest sine to the axis among its binned bearings
-  std::vector<Entry> near_;       // near the axis, any octave
+  std::vector<int32_t> start_;   // octaves * kBins + 1
+  std::vector<float> min_sine_;  // per octave: smallest sine to the axis among its binned bearings
+  std::vector<Entry> near_;      // near the axis, any octave
   std::vector<int8_t> near_octave_;
   int near_count_ = 0;
 };
 
 template <class F>
-bool EpipolarBandIndex::forEachOnPlane(const Vec3& ray, int octave_lo, int octave_hi, const double* gate,
-                                       F&& f) const {
+bool EpipolarBandIndex::forEachOnPlane(const Vec3& ray, int octave_lo, int octave_hi, const double* gate, F&& f) const {
   const double x = u_.dot(ray), y = v_.dot(ray);
   const double sine = std::sqrt(x * x + y * y);
   if (sine < 1e-9) return false;
-  const Vec3 n = (axis_.cross(ray)) / sine;  // normal of the ray's epipolar plane
+  const Vec3 n = (axis_.cross(ray)) / sine;        // normal of the ray's epipolar plane
   const Vec3 perp = ray - axis_ * axis_.dot(ray);  // its half-plane
   const float nf[3] = {static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z())};
   const float pf[3] = {static_cast<float>(perp.x()), static_cast<float>(perp.y()), static_cast<float>(perp.z())};

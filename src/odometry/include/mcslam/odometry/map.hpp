@@ -25,17 +25,17 @@ struct LandmarkObservation {
 
 struct Landmark {
   bool alive = false;
-  int64_t id = -1;                 // unique over the run; the back-end's window knows the landmark by it
+  int64_t id = -1;  // unique over the run; the back-end's window knows the landmark by it
   Vec3 p_w = Vec3::Zero();
   Descriptor descriptor{};
   int obs_count = 0;
   LandmarkObservation obs[kMaxLandmarkObservations];
   int64_t created_keyframe_id = -1;
-  float max_distance = 0;          // distances over which ORB can find it again (scale invariance)
+  float max_distance = 0;  // distances over which ORB can find it again (scale invariance)
   float min_distance = 0;
   bool in_backend = false;
-  bool frozen = false;             // left the back-end by marginalization: kept fixed for tracking
-  bool metric = false;             // triangulated with enough certainty to fix scale
+  bool frozen = false;  // left the back-end by marginalization: kept fixed for tracking
+  bool metric = false;  // triangulated with enough certainty to fix scale
 };
 
 struct Keyframe {
@@ -73,13 +73,13 @@ class Map {
   }
 
   // Keyframes.
-  int createKeyframe();  // slot of a fresh keyframe, -1 when the pool is full
+  int createKeyframe();          // slot of a fresh keyframe, -1 when the pool is full
   void eraseKeyframe(int slot);  // removes its observations; landmarks left unobserved die
   Keyframe& keyframe(int slot) { return keyframes_[slot]; }
   const Keyframe& keyframe(int slot) const { return keyframes_[slot]; }
   int keyframeCapacity() const { return static_cast<int>(keyframes_.size()); }
   int liveKeyframes() const;
-  int oldestKeyframe() const;  // slot, -1 when none
+  int oldestKeyframe() const;        // slot, -1 when none
   int oldestWindowKeyframe() const;  // slot of the oldest keyframe in the back-end's window, -1 when none
   int newestKeyframe() const;
 

@@ -22,7 +22,7 @@ struct OdometryStats {
   uint64_t lost = 0;
   uint64_t initializations = 0;
   uint64_t keyframes = 0;
-  uint64_t recoveries = 0;          // frames tracked only through the descriptor fallback
+  uint64_t recoveries = 0;  // frames tracked only through the descriptor fallback
   uint64_t backend_solves = 0;
   uint64_t extrinsic_reestimations = 0;  // cameras whose extrinsic the per-camera check replaced
   double last_backend_ms = 0;
@@ -31,16 +31,16 @@ struct OdometryStats {
   int64_t scale_converged_frame = -1;
   uint64_t scale_estimates = 0;
   uint64_t scale_rescales = 0;
-  double last_scale = 1;              // factor of the last window estimate
-  double last_scale_sigma = INFINITY; // its sigma(s) / s
+  double last_scale = 1;                   // factor of the last window estimate
+  double last_scale_sigma = INFINITY;      // its sigma(s) / s
   double combined_scale_sigma = INFINITY;  // of the estimates combined (ScaleFilter)
 };
 
 // Milliseconds spent in the stages of the last processed frame.
 struct OdometryTiming {
-  double tracking_ms = 0;   // pose estimation and keyframe decision
-  double mapping_ms = 0;    // keyframe insertion and new landmarks
-  double backend_ms = 0;    // sliding-window optimization
+  double tracking_ms = 0;  // pose estimation and keyframe decision
+  double mapping_ms = 0;   // keyframe insertion and new landmarks
+  double backend_ms = 0;   // sliding-window optimization
 };
 
 class ExtrinsicCheck;
@@ -95,8 +95,7 @@ class Odometry {
   // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.
   void lose(uint64_t frame_index, int inliers, PoseEstimate& out);
   // A keyframe of the tracked frame: its landmarks, new points, and its back-end solve started.
-  void makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers,
-                    PoseEstimate& out);
+  void makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers, PoseEstimate& out);
   // New landmarks across time for keyframe `slot` (TemporalTriangulator); returns how many.
   int triangulateNew(int slot);
   void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
@@ -117,11 +116,11 @@ class Odometry {
   std::unique_ptr<ScaleSupervisor> scale_;
 
   bool initialized_ = false;
-  SE3 anchor_;                    // pose given to the next initialization (continuity after a loss)
-  int pending_keyframe_ = -1;     // keyframe whose back-end solve has not been applied yet
+  SE3 anchor_;                 // pose given to the next initialization (continuity after a loss)
+  int pending_keyframe_ = -1;  // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
   int64_t last_init_reference_ = -1;
-  uint64_t frame_index_ = 0;      // of the frame being processed
+  uint64_t frame_index_ = 0;  // of the frame being processed
   OdometryStats stats_;
   OdometryTiming timing_;
 };

@@ -7,8 +7,8 @@ namespace mcslam {
 
 struct OdometryOptions {
   // Capacities.
-  int max_keyframes = 14;      // keyframe pool: the back-end window plus older keyframes kept for tracking
-  int window_keyframes = 8;    // keyframes optimized together by the back-end
+  int max_keyframes = 14;    // keyframe pool: the back-end window plus older keyframes kept for tracking
+  int window_keyframes = 8;  // keyframes optimized together by the back-end
   int max_landmarks = 16000;
 
   // ORB pyramid (must match the extractor): sigma of a keypoint = scale_factor^octave pixels.
@@ -16,24 +16,25 @@ struct OdometryOptions {
   int levels = 8;
 
   // Matching by projection.
-  int max_hamming = 80;              // of 256 bits
-  float ratio = 0.85f;               // best / second best when both are in the same octave
-  double track_radius_px = 15.0;     // search radius around the motion-model prediction (octave 0)
-  double wide_radius_factor = 4.0;   // radius factor of the second attempt when the first finds too little
-  double local_map_radius_px = 4.0;  // radius for the local map, once the pose is known
-  int min_matches_for_pose = 12;     // RANSAC needs at least this many matches to try
-  int min_tracked = 12;              // fewer inliers after refinement: the frame is lost
+  int max_hamming = 80;                 // of 256 bits
+  float ratio = 0.85f;                  // best / second best when both are in the same octave
+  double track_radius_px = 15.0;        // search radius around the motion-model prediction (octave 0)
+  double wide_radius_factor = 4.0;      // radius factor of the second attempt when the first finds too little
+  double local_map_radius_px = 4.0;     // radius for the local map, once the pose is known
+  int min_matches_for_pose = 12;        // RANSAC needs at least this many matches to try
+  int min_tracked = 12;                 // fewer inliers after refinement: the frame is lost
   double strong_tracking_share = 0.25;  // a coarse pose is trusted with this share of the previous frame's inliers
 
   // Keyframes.
-  double keyframe_tracked_ratio = 0.75;  // new keyframe when tracked landmarks fall below this share of the last keyframe's
-  int keyframe_max_interval = 8;         // frames: at least one keyframe per this many
+  double keyframe_tracked_ratio =
+      0.75;                       // new keyframe when tracked landmarks fall below this share of the last keyframe's
+  int keyframe_max_interval = 8;  // frames: at least one keyframe per this many
   double keyframe_rotation_deg = 8.0;
   double keyframe_translation_ratio = 0.08;  // translation / median scene depth since the last keyframe
 
   // Initialization.
-  int init_min_multiview = 40;     // metric multi-view features needed to initialize from one frame
-  int init_max_reference_age = 40; // two-frame initialization: renew the reference frame after this many frames
+  int init_min_multiview = 40;      // metric multi-view features needed to initialize from one frame
+  int init_max_reference_age = 40;  // two-frame initialization: renew the reference frame after this many frames
   int init_min_matches = 60;
   // Scale of a rig without overlap, estimated over the map's newest keyframes: the map becomes metric when the
   // estimate's sigma(s)/s is below this (3 sigma inside the 5% the issue asks for), searched within this
@@ -59,10 +60,10 @@ struct OdometryOptions {
   // across keyframes (the back-end refines both); a stricter one left distant scenes seen by two cameras with
   // too few points to start from.
   double landmark_max_depth_sigma = 0.15;
-  int temporal_keyframes = 5;            // previous keyframes searched for new points (newest first)
-  TriangulationOptions new_points;       // acceptance of new points triangulated across keyframes
-  int cull_min_visible = 8;              // frames a landmark must have been predicted before its ratio counts
-  double cull_min_found_ratio = 0.25;    // found / visible below this: erased
+  int temporal_keyframes = 5;          // previous keyframes searched for new points (newest first)
+  TriangulationOptions new_points;     // acceptance of new points triangulated across keyframes
+  int cull_min_visible = 8;            // frames a landmark must have been predicted before its ratio counts
+  double cull_min_found_ratio = 0.25;  // found / visible below this: erased
 
   // Back-end.
   bool backend = true;

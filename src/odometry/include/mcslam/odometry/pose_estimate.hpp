@@ -24,13 +24,13 @@ inline const char* trackingStateName(TrackingState s) {
 }
 
 struct PoseEstimate {
-  Timestamp t = 0;           // capture time of the frame, ns
+  Timestamp t = 0;  // capture time of the frame, ns
   uint64_t sequence = 0;
-  SE3 T_w_b;                 // body in world (world = body at the first frame)
+  SE3 T_w_b;  // body in world (world = body at the first frame)
   TrackingState state = TrackingState::NotInitialized;
-  float quality = 0;         // 0..1: share of expected landmark matches that were inliers
+  float quality = 0;  // 0..1: share of expected landmark matches that were inliers
   bool is_keyframe = false;
-  bool valid = false;        // T_w_b holds an estimate
+  bool valid = false;  // T_w_b holds an estimate
   // T_w_b.t is in metres. False when its unit is arbitrary: one camera, or a rig without overlap whose map
   // started up to scale and has not yet found it.
   bool metric = true;

@@ -48,8 +48,8 @@ class ScaleEstimator {
  public:
   // max_observations: observations of window landmarks by window keyframes (window * cameras * features);
   // max_keyframes: the map's keyframe capacity. All scratch is allocated here: estimate() allocates nothing.
-  ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes,
-                 float octave_scale_factor, int levels);
+  ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes, float octave_scale_factor,
+                 int levels);
   // Takes the current extrinsics by value (estimate() uses them); allocates nothing.
   void follow(const RigState& state) { rig_ = state.rig(); }
 
@@ -65,15 +65,15 @@ class ScaleEstimator {
   using Reduced = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDim, kMaxDim>;
   using ReducedVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDim, 1>;
   struct Obs {
-    int16_t kf;   // index into kf_T_
+    int16_t kf;  // index into kf_T_
     int16_t cam;
     Vec2 uv;
     double inv_sigma;
   };
-  class Problem;  // the Levenberg-Marquardt problem of refine()
-  bool selectWindow(const Map& map, ScaleEstimate& out);    // keyframes: kf_T_, oldest_, out's window fields
+  class Problem;                                              // the Levenberg-Marquardt problem of refine()
+  bool selectWindow(const Map& map, ScaleEstimate& out);      // keyframes: kf_T_, oldest_, out's window fields
   void collectLandmarks(const Map& map, const Vec3& center);  // lm_p_, lm_first_, obs_
-  bool profileScale(double max_ratio);                         // the coarse search
+  bool profileScale(double max_ratio);                        // the coarse search
   double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
   // Robust cost of landmark l at p, keyframes at kf_T_; p is refined first (two Gauss-Newton steps).
   double landmarkCost(int l, Vec3& p);
@@ -88,20 +88,20 @@ class ScaleEstimator {
   // and the variance of u it implies. False when not finite.
   bool reducedSystem(double& chi2, int& residuals);
   bool dampedStep(double mu, ReducedVec& step);  // solves (S + mu D) step = -b (backend::dampedMatrix)
-  double scaleOfPoses() const;  // summed distances of the keyframes from the oldest (the centre)
+  double scaleOfPoses() const;                   // summed distances of the keyframes from the oldest (the centre)
   // Block of window keyframe w in the reduced pose system (-1: the oldest, held).
   int freeIndex(int w) const { return w == oldest_ ? -1 : (w < oldest_ ? w : w - 1); }
 
   Rig rig_;  // a copy: follow() moves its extrinsics
   backend::RobustLoss loss_;
   std::vector<double> octave_sigma_;
-  std::vector<SE3> T_c_b_;     // per camera, from the rig at the start of estimate() (its extrinsics may follow
-                               // the back-end's)
-  std::vector<SE3> kf_T_;      // per window keyframe: T_w_b, translation relative to the centre
+  std::vector<SE3> T_c_b_;      // per camera, from the rig at the start of estimate() (its extrinsics may follow
+                                // the back-end's)
+  std::vector<SE3> kf_T_;       // per window keyframe: T_w_b, translation relative to the centre
   std::vector<SE3> kf_before_;  // kf_T_ before a refinement step
   std::vector<SE3> kf_start_, kf_best_;  // the window as the map has it, and the profile's best fit
   std::vector<Vec3> lm_start_, lm_best_;
-  int oldest_ = 0;              // window index of the oldest keyframe (held)
+  int oldest_ = 0;                   // window index of the oldest keyframe (held)
   backend::SchurAccumulator schur_;  // eliminates the landmarks from the reduced pose system
   Reduced S_, damped_;
   ReducedVec b_, g_;
@@ -110,8 +110,8 @@ class ScaleEstimator {
   double held_u_ = 0;
   std::vector<int> kf_slot_of_;  // map keyframe slot -> window index (-1)
   std::vector<int> kf_order_;    // window index -> map keyframe slot (the first nk_), then the other live ones
-  std::vector<Vec3> lm_p_;      // per landmark: position relative to the centre
-  std::vector<int> lm_first_;   // per landmark: first observation (lm_first_[l + 1] ends it)
+  std::vector<Vec3> lm_p_;       // per landmark: position relative to the centre
+  std::vector<int> lm_first_;    // per landmark: first observation (lm_first_[l + 1] ends it)
   std::vector<Obs> obs_;
   int nk_ = 0, nl_ = 0, no_ = 0;
 };

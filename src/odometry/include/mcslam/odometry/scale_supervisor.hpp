@@ -28,7 +28,7 @@ class ScaleSupervisor {
   void start(bool unscaled);
 
   struct Rescale {
-    bool apply = false;      // multiply positions about `center` by `s`
+    bool apply = false;  // multiply positions about `center` by `s`
     double s = 1;
     Vec3 center = Vec3::Zero();
     bool converged = false;  // the first rescale of a certain estimate: the map is metric from now on

@@ -65,10 +65,10 @@ class TemporalTriangulator {
   bool landmarks_compete_ = false;  // of the call in progress
   std::vector<double> half_fov_;    // per camera: CameraModel::imageHalfAngle()
   std::vector<Candidate> candidates_;
-  std::vector<int32_t> claim_;      // per (camera, keypoint) of the old keyframe: best candidate index
+  std::vector<int32_t> claim_;  // per (camera, keypoint) of the old keyframe: best candidate index
   std::vector<Best> best_;
-  EpipolarBandIndex band_index_;    // the old camera's keypoints, by epipolar half-plane
-  std::vector<double> gate_;        // per octave: sine distance to the epipolar plane allowed
+  EpipolarBandIndex band_index_;        // the old camera's keypoints, by epipolar half-plane
+  std::vector<double> gate_;            // per octave: sine distance to the epipolar plane allowed
   std::vector<double> inverse_ranges_;  // scratch of sceneInverseDepth(): one per keypoint of a keyframe
   std::vector<TriangulationObservation> tri_obs_;
   std::vector<KeypointRef> tri_refs_;  // keyframe-tagged refs in tri_obs_ order (cam, index)

@@ -86,8 +86,8 @@ class Tracker {
   OctaveScales octave_scale_{options_.scale_factor};
 
   bool have_velocity_ = false;
-  SE3 T_w_last_;                  // pose of the previous frame
-  SE3 velocity_;                  // relative motion of the last frame step
+  SE3 T_w_last_;  // pose of the previous frame
+  SE3 velocity_;  // relative motion of the last frame step
   uint64_t last_keyframe_frame_ = 0;
   SE3 last_keyframe_pose_;
   int last_keyframe_tracked_ = 0;

@@ -71,8 +71,8 @@ class WindowBridge {
   void writeBack(Map& map);
   int keyframeSlotOfId(const Map& map, int64_t id) const;
 
-  RigState rig_state_;  // with refinement on, its extrinsics follow the estimates
-  Rig calibration_;     // the window's prior, also for a new window after a reset
+  RigState rig_state_;                        // with refinement on, its extrinsics follow the estimates
+  Rig calibration_;                           // the window's prior, also for a new window after a reset
   std::vector<uint8_t> calibration_dropped_;  // per camera: reestimateExtrinsic() showed its calibration wrong
   OdometryOptions options_;
   int capacity_;

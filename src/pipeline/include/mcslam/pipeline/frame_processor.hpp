@@ -14,8 +14,8 @@ namespace mcslam {
 
 // One synchronized capture of the rig. images[c] is valid when present[c] is true.
 struct RigFrameView {
-  Timestamp t = 0;           // capture time, ns
-  uint64_t sequence = 0;     // trigger count / frame index
+  Timestamp t = 0;        // capture time, ns
+  uint64_t sequence = 0;  // trigger count / frame index
   int cameras = 0;
   const ImageView* images = nullptr;
   const bool* present = nullptr;

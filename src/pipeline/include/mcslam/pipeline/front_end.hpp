@@ -48,7 +48,8 @@ class FrontEnd {
     FrameFeatures* frame_ = nullptr;
   };
 
-  // The subpixel alignment of the frame's tracks (on by default), as tasks of the ORB workers once the tracks are merged.
+  // The subpixel alignment of the frame's tracks (on by default), as tasks of the ORB workers once the tracks are
+  // merged.
   class AlignmentTasks : public WorkerTasks {
    public:
     explicit AlignmentTasks(MultiViewMatcher& matcher) : matcher_(matcher) {}

@@ -25,7 +25,7 @@ const char* refineExtrinsicsName(RefineExtrinsics r);
 
 struct PipelineConfig {
   OrbOptions orb;
-  int feature_threads = 0;              // 0: one per core, at most one per camera
+  int feature_threads = 0;  // 0: one per core, at most one per camera
   OverlapOptions overlap;
   MultiViewOptions multiview;
   OdometryOptions odometry;

@@ -80,8 +80,8 @@ class SlamPipeline final : public FrameProcessor {
   // reader.
   bool handover_ = false;
   std::vector<RigState> rig_after_;  // two slots when handover_
-  uint64_t features_computed_ = 0;  // touched by the front-end's thread only
-  uint64_t frames_tracked_ = 0;     // by the tracking thread only
+  uint64_t features_computed_ = 0;   // touched by the front-end's thread only
+  uint64_t frames_tracked_ = 0;      // by the tracking thread only
 };
 
 // Resolves `refine_extrinsics: auto` for the rig and overlap.

@@ -37,10 +37,10 @@ class StageSlots {
   void close();
 
  protected:
-  int reserve();                                     // preparing thread: waits for a free slot
+  int reserve();                                      // preparing thread: waits for a free slot
   void prepare(int slot, const RigFrameView& frame);  // prepares into it and hands it over
-  int next();                                        // finishing thread: waits; -1 when closed and all finished
-  void finish(int slot, PoseEstimate& out);          // finishes it; the slot is free again
+  int next();                                         // finishing thread: waits; -1 when closed and all finished
+  void finish(int slot, PoseEstimate& out);           // finishes it; the slot is free again
 
  private:
   void signal();

@@ -17,7 +17,7 @@ namespace mcslam::sim {
 struct ExportOptions {
   std::vector<int> cameras;  // calibration indices to write; empty = all
   bool depth = true;
-  std::string description;   // free text recorded in sim.yaml
+  std::string description;                            // free text recorded in sim.yaml
   std::function<void(int done, int total)> progress;  // called after each frame
 };
 

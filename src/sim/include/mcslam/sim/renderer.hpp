@@ -40,8 +40,8 @@ enum class DepthKind {
 
 struct SensorOptions {
   bool noise = true;
-  double read_noise = 0.0012;     // standard deviation in linear full-scale units (about 1.5 grey levels in shadows)
-  double shot_noise = 1.5e-4;     // variance per unit of linear signal (photon noise)
+  double read_noise = 0.0012;  // standard deviation in linear full-scale units (about 1.5 grey levels in shadows)
+  double shot_noise = 1.5e-4;  // variance per unit of linear signal (photon noise)
   bool vignetting = true;
   double vignetting_strength = 0.45;  // gain 1 - s * sin^2(angle off the optical axis), at least 0.3
   bool exposure_variation = true;     // per-camera gain offsets (+-10%) and a slow common drift (+-12%)
@@ -51,11 +51,11 @@ struct SensorOptions {
 };
 
 struct RenderOptions {
-  int threads = 0;              // 0 = one per hardware thread
-  bool anti_aliasing = true;    // supersample silhouette and face-border pixels
-  int edge_samples = 8;         // samples per supersampled pixel
-  int tile_size = 16;           // pixels per tile side (candidate culling granularity)
-  uint64_t seed = 1;            // sensor noise and exposure drift
+  int threads = 0;            // 0 = one per hardware thread
+  bool anti_aliasing = true;  // supersample silhouette and face-border pixels
+  int edge_samples = 8;       // samples per supersampled pixel
+  int tile_size = 16;         // pixels per tile side (candidate culling granularity)
+  uint64_t seed = 1;          // sensor noise and exposure drift
   DepthKind depth = DepthKind::OpticalAxisZ;
   SensorOptions sensor;
 };

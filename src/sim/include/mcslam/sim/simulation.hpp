@@ -27,11 +27,11 @@ struct SimulationConfig {
   std::string world = "indoor";       // indoor, corridor, courtyard
   std::string trajectory = "ground";  // ground, handheld, file:PATH
   double rate_hz = 10.0;
-  int frames = 0;                     // 0: as many as the trajectory lasts
-  uint64_t seed = 1;                  // world layout and textures, trajectory wobble, sensor noise
+  int frames = 0;     // 0: as many as the trajectory lasts
+  uint64_t seed = 1;  // world layout and textures, trajectory wobble, sensor noise
   bool moving_objects = false;
-  std::string textures_dir;           // photographs instead of procedural textures
-  RenderOptions render;               // its seed is replaced by `seed`
+  std::string textures_dir;  // photographs instead of procedural textures
+  RenderOptions render;      // its seed is replaced by `seed`
 };
 
 class Simulation {

@@ -40,18 +40,18 @@ class PlatformTrajectory : public SimTrajectory {
 };
 
 struct GroundOptions {
-  double cruise_speed = 1.0;        // m/s on straights
-  double max_yaw_rate_deg = 50.0;   // turn-rate limit that sets corner speeds
-  double lateral_accel = 0.9;       // m/s^2 limit in corners
-  double accel = 0.5;               // m/s^2 speeding up and slowing down
-  double stop_seconds = 2.0;        // pause at each of the route's stops
-  double height = 1.0;              // rig centre above the floor, m
-  bool bumps = true;                // vibration and door-threshold bumps
+  double cruise_speed = 1.0;       // m/s on straights
+  double max_yaw_rate_deg = 50.0;  // turn-rate limit that sets corner speeds
+  double lateral_accel = 0.9;      // m/s^2 limit in corners
+  double accel = 0.5;              // m/s^2 speeding up and slowing down
+  double stop_seconds = 2.0;       // pause at each of the route's stops
+  double height = 1.0;             // rig centre above the floor, m
+  bool bumps = true;               // vibration and door-threshold bumps
 };
 
 struct HandheldOptions {
-  double speed = 1.0;     // walking speed, m/s
-  double height = 1.45;   // rig centre above the floor, m
+  double speed = 1.0;    // walking speed, m/s
+  double height = 1.45;  // rig centre above the floor, m
 };
 
 // Ground robot on the world's route. Throws InputError when the route is not clear of the geometry.

@@ -19,31 +19,31 @@ namespace mcslam::sim {
 // Procedural texture families (each has many seeded variants). With WorldOptions::textures_dir the
 // families listed as photographic in texture_kinds.cpp are replaced by photographs.
 enum class TextureKind : uint8_t {
-  Plaster,      // painted wall: almost featureless (the low-texture stretches)
-  Concrete,     // multi-scale noise, pores, formwork seams
-  Brick,        // running bond with mortar
-  WoodPlanks,   // floor boards with grain
-  WoodPanel,    // furniture laminate
-  Tiles,        // terrazzo floor tiles with grout
-  Linoleum,     // mottled, low contrast
-  Carpet,       // carpet tiles
-  Fabric,       // woven upholstery
-  Metal,        // brushed metal
-  CeilingTiles, // acoustic ceiling grid
-  Poster,       // printed graphics and text (use Material::fit)
-  NoticeBoard,  // cork with pinned notes
-  Whiteboard,   // marker scribbles
-  Books,        // shelf rows of book spines
-  Door,         // panel door (use Material::fit)
-  Cabinet,      // doors and drawers with handles
-  Facade,       // building front: storeys of windows
-  Paving,       // paving stones
+  Plaster,       // painted wall: almost featureless (the low-texture stretches)
+  Concrete,      // multi-scale noise, pores, formwork seams
+  Brick,         // running bond with mortar
+  WoodPlanks,    // floor boards with grain
+  WoodPanel,     // furniture laminate
+  Tiles,         // terrazzo floor tiles with grout
+  Linoleum,      // mottled, low contrast
+  Carpet,        // carpet tiles
+  Fabric,        // woven upholstery
+  Metal,         // brushed metal
+  CeilingTiles,  // acoustic ceiling grid
+  Poster,        // printed graphics and text (use Material::fit)
+  NoticeBoard,   // cork with pinned notes
+  Whiteboard,    // marker scribbles
+  Books,         // shelf rows of book spines
+  Door,          // panel door (use Material::fit)
+  Cabinet,       // doors and drawers with handles
+  Facade,        // building front: storeys of windows
+  Paving,        // paving stones
   Grass,
   Foliage,
   Bark,
   Asphalt,
-  Person,       // clothing, for moving objects
-  Radiator,     // vertical ribs
+  Person,    // clothing, for moving objects
+  Radiator,  // vertical ribs
   Count
 };
 const char* textureKindName(TextureKind kind);
@@ -52,12 +52,12 @@ const char* textureKindName(TextureKind kind);
 struct Material {
   bool textured = false;
   TextureKind kind = TextureKind::Plaster;
-  int variant = -1;            // which texture of the family; -1 = picked from the seed and the face
-  double albedo = 0.6;         // uniform albedo, or the factor applied to the texture's albedo
-  double texel_size = 0.002;   // metres per texel when tiling (finer = smaller pattern)
-  bool fit = false;            // stretch one copy of the texture over the face (posters, doors, markers)
-  double emission = 0.0;       // self-emitted radiance, added after lighting (lamps, lit windows)
-  bool lit = true;             // false: no baked lighting (faces nobody sees, e.g. the outside of walls)
+  int variant = -1;           // which texture of the family; -1 = picked from the seed and the face
+  double albedo = 0.6;        // uniform albedo, or the factor applied to the texture's albedo
+  double texel_size = 0.002;  // metres per texel when tiling (finer = smaller pattern)
+  bool fit = false;           // stretch one copy of the texture over the face (posters, doors, markers)
+  double emission = 0.0;      // self-emitted radiance, added after lighting (lamps, lit windows)
+  bool lit = true;            // false: no baked lighting (faces nobody sees, e.g. the outside of walls)
 
   static Material uniform(double albedo) {
     Material m;
@@ -116,18 +116,18 @@ struct RouteSpec {
 // A person-sized box walking back and forth between two points (smooth turnarounds).
 struct Walker {
   Vec2 a = Vec2::Zero(), b = Vec2(4, 0);
-  double speed = 1.2;        // peak speed, m/s
-  double phase = 0.0;        // seconds of offset along the cycle
+  double speed = 1.2;                          // peak speed, m/s
+  double phase = 0.0;                          // seconds of offset along the cycle
   Vec3 half_extents = Vec3(0.15, 0.25, 0.87);  // along its walking direction, across, up
-  int variant = -1;          // Person texture variant
+  int variant = -1;                            // Person texture variant
 };
 
 struct RayHit {
-  double t = 0;             // distance along the (unit) ray, metres
+  double t = 0;  // distance along the (unit) ray, metres
   Vec3 point = Vec3::Zero();
   Vec3 normal = Vec3::UnitZ();
-  int object = -1;          // static object index (builder order), or walker index when moving
-  int face = 0;             // BoxFace or CylinderFace
+  int object = -1;  // static object index (builder order), or walker index when moving
+  int face = 0;     // BoxFace or CylinderFace
   bool moving = false;
 };
 
