@@ -5,20 +5,18 @@
 #include <thread>
 #include <vector>
 
+#include "alloc_testing.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 
 using namespace mcslam;
 
-#define SKIP_WITHOUT_HOOKS() \
-  if (!alloc::available()) GTEST_SKIP() << "allocation hooks are left out of sanitizer builds"
-
 TEST(AllocCounter, HooksAreLinkedIntoTests) {
-  SKIP_WITHOUT_HOOKS();
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   EXPECT_TRUE(alloc::available());
 }
 
 TEST(AllocCounter, CountsNewMallocAndEigen) {
-  SKIP_WITHOUT_HOOKS();
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   alloc::ThreadScope scope;
   auto* v = new std::vector<int>(100);
   EXPECT_EQ(scope.count(), 2u);  // the vector object and its buffer
@@ -32,7 +30,7 @@ TEST(AllocCounter, CountsNewMallocAndEigen) {
 }
 
 TEST(AllocCounter, CountsPerThread) {
-  SKIP_WITHOUT_HOOKS();
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   alloc::ThreadScope scope;
   std::thread t([] {
     std::vector<int> v(10);

@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "alloc_testing.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/worker_pool.hpp"
@@ -178,7 +179,7 @@ TEST(WorkerPool, WritesAreVisibleAcrossSubmitWaitAndBatches) {
 }
 
 TEST(WorkerPool, BatchesAllocateNothingAfterWarmUp) {
-  if (!alloc::available()) GTEST_SKIP() << "allocation hooks are left out of sanitizer builds";
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   WorkerPool pool(2);
   CountingJob job(64, 2);
   std::atomic<int> sum{0};

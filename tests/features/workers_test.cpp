@@ -6,6 +6,7 @@
 #include <atomic>
 #include <thread>
 
+#include "alloc_testing.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/features/feature_workers.hpp"
@@ -115,7 +116,7 @@ TEST(FeatureWorkers, ImageLargerThanItsCameraIsRefusedEvenIfAnotherCameraIsThatL
 }
 
 TEST(FeatureWorkers, RigFramesAllocateNothingOnAnyThread) {
-  ASSERT_TRUE(alloc::available());
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   FeatureWorkers workers(options(), rig().sizes, 2);
   std::vector<FeatureSet> out = makeSets();
   const bool present[kCameras] = {true, true, false, true, true};
@@ -188,7 +189,7 @@ TEST(FeatureWorkers, FollowUpTasksRunOnceEachAfterBothOfTheirCameras) {
 }
 
 TEST(FeatureWorkers, FollowUpAllocatesNothingPerFrame) {
-  ASSERT_TRUE(alloc::available());
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   FeatureWorkers workers(options(), rig().sizes, 2);
   std::vector<FeatureSet> out = makeSets();
   RecordingFollowUp follow_up(out);

@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include "alloc_testing.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/odometry/landmark_tracks.hpp"
 #include "mcslam/odometry/map.hpp"
@@ -84,7 +85,7 @@ TEST(RigState, AConsumerKeepsTheValuesItReceivedUntilItFollowsAgain) {
 }
 
 TEST(RigState, FollowingAllocatesNothing) {
-  if (!alloc::available()) GTEST_SKIP() << "allocation counting is not linked";
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   const Rig rig = test::isecRig();
   RigState producer(rig), consumer(rig);
   alloc::ThreadScope scope;

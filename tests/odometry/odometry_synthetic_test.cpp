@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "alloc_testing.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/features/multiview_matcher.hpp"
@@ -77,7 +78,7 @@ TEST(OdometrySynthetic, FiveOverlappingCameras) {
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_EQ(r.stats.initializations, 1u);
   EXPECT_LT(r.ate, 0.05);
-  if (alloc::available()) {
+  if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);  // keyframes, mapping and back-end (its thread too) included
   }
 }
@@ -89,7 +90,7 @@ TEST(OdometrySynthetic, Stereo) {
   EXPECT_LT(r.ate, 0.08);
   EXPECT_EQ(r.tracked_after_metric, static_cast<int>(r.estimate.size())) << "a metric start: every pose in metres";
   EXPECT_EQ(r.unscaled_after_metric, 0);
-  if (alloc::available()) {
+  if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }
 }
@@ -101,7 +102,7 @@ static void expectMetricScaleOnceConverged(const test::SyntheticSequenceOptions&
   const RunResult r = runSequence(test::nonOverlappingRig3(), so, true);
   EXPECT_EQ(r.stats.lost, 0u);
   // Scale estimates and rescales included (the first estimate of the rectangle comes after the warm-up).
-  if (alloc::available()) {
+  if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }
   ASSERT_GE(r.stats.scale_converged_frame, 0) << "the map should start up to scale and then converge";
@@ -181,7 +182,7 @@ TEST(OdometrySynthetic, OneCameraUpToScale) {
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_GT(r.stats.tracking, 150u);
   EXPECT_EQ(r.first_metric, -1) << "one camera's poses never are in metres";
-  if (alloc::available()) {
+  if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include "alloc_testing.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/odometry/scale_estimator.hpp"
@@ -99,7 +100,7 @@ TEST(ScaleEstimator, StraightWindowLeavesTheScaleOpen) {
 // one and one over a smaller window included. (The first estimate once sized the keyframe table: a rig whose
 // first turn came after the warm-up allocated then, and again after every re-initialization.)
 TEST(ScaleEstimator, EstimatesAllocateNothing) {
-  if (!alloc::available()) GTEST_SKIP() << "allocation counting is not linked";
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   const Rig rig = test::nonOverlappingRig3();
   Map map(rig, 2000, 14, 4000);
   buildWindow(rig, map, 60.0, 2.5, 0.5);

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "alloc_testing.hpp"
 #include "daemon/daemon.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon/supervisor.hpp"
@@ -265,7 +266,7 @@ TEST_F(DaemonTest, SoftwareTriggerDrivesTheReplayAndLatencyIsMeasured) {
 }
 
 TEST_F(DaemonTest, NoDaemonThreadAllocatesPerFrameAfterWarmup) {
-  ASSERT_TRUE(alloc::available());
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   // 5 cameras, preloaded and looped, as fast as the pipeline takes them: thousands of frames quickly.
   const std::string data = test::writeSmallDataset(dir_.file("data"), 5, 20, 64, 48);
   const int rx = udpReceiver(udp_port_);
@@ -284,7 +285,7 @@ TEST_F(DaemonTest, NoDaemonThreadAllocatesPerFrameAfterWarmup) {
 }
 
 TEST_F(DaemonTest, ReplayingPgmFromDiskAllocatesNothingPerFrameAfterWarmup) {
-  ASSERT_TRUE(alloc::available());
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
   // As above without preload: every image is read from its PGM file into the camera ring's slot, every frame.
   // (PNG decoding through the image codec module allocates, about 95 times per rig frame of 5 cameras.)
   const std::string data = test::writeSmallPgmDataset(dir_.file("data"), 5, 20, 64, 48);

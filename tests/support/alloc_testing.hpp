@@ -1,0 +1,24 @@
+#pragma once
+// Whether a test can count heap allocations. The counting hooks replace malloc, which the sanitizers own: sanitizer
+// builds leave the hooks out (GCC says so with __SANITIZE_*__) and the counting assertions skip there. In every other build a test
+// without the hooks is a mistake in its CMake (ALLOC_HOOKS missing) and fails.
+#include <gtest/gtest.h>
+
+#include "mcslam/core/alloc_counter.hpp"
+
+namespace mcslam::test {
+
+inline bool countsAllocations() {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  return false;
+#else
+  if (!alloc::available()) ADD_FAILURE() << "allocation hooks not linked: give the test ALLOC_HOOKS in its CMakeLists";
+  return alloc::available();
+#endif
+}
+
+}  // namespace mcslam::test
+
+// For a test that asserts nothing but allocation counts.
+#define SKIP_UNLESS_COUNTING_ALLOCATIONS() \
+  if (!::mcslam::test::countsAllocations()) GTEST_SKIP() << "sanitizer build: allocation hooks left out"
