@@ -14,12 +14,12 @@ case "${1:-}" in
 esac
 
 if ((ci)); then
+  tools/check-format.sh  # first: it takes seconds, the rest half an hour
   MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" tools/setup.sh
 else
   tools/setup.sh
 fi
 ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
 if ((ci)); then
-  tools/check-format.sh
   tools/run-sanitizers.sh all
 fi

@@ -1,7 +1,7 @@
 #pragma once
 // Whether a test can count heap allocations. The counting hooks replace malloc, which the sanitizers own: sanitizer
-// builds leave the hooks out (GCC says so with __SANITIZE_*__) and the counting assertions skip there. In every other build a test
-// without the hooks is a mistake in its CMake (ALLOC_HOOKS missing) and fails.
+// builds leave the hooks out (GCC says so with __SANITIZE_*__) and the counting assertions skip there. In every other
+// build a test without the hooks is a mistake in its CMake (ALLOC_HOOKS missing) and fails.
 #include <gtest/gtest.h>
 
 #include "mcslam/core/alloc_counter.hpp"
