@@ -3,8 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon/source_factory.hpp"
-#include "daemon/synced_file.hpp"
 #include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/synced_file.hpp"
 #include "realtime/scheduling.hpp"
 
 namespace mcslam::platform {
