@@ -55,9 +55,8 @@ int LocalMapper::allocateKeyframe(Map& map, WindowBridge& bridge) {
   return map.createKeyframe();
 }
 
-int LocalMapper::insertKeyframe(Map& map, WindowBridge& bridge, const Rig& rig, const FrameFeatures& frame,
-                                const FrameMatches* matches, const SE3& T_w_b, uint64_t frame_index,
-                                bool create_multiview_points) {
+int LocalMapper::startKeyframe(Map& map, WindowBridge& bridge, const FrameFeatures& frame, const SE3& T_w_b,
+                               uint64_t frame_index) {
   const int slot = allocateKeyframe(map, bridge);
   if (slot < 0) return -1;
   Keyframe& kf = map.keyframe(slot);
@@ -65,7 +64,14 @@ int LocalMapper::insertKeyframe(Map& map, WindowBridge& bridge, const Rig& rig, 
   kf.T_w_b = T_w_b;
   kf.t = frame.t;
   kf.frame_index = frame_index;
+  return slot;
+}
 
+int LocalMapper::insertKeyframe(Map& map, WindowBridge& bridge, const Rig& rig, const FrameFeatures& frame,
+                                const FrameMatches* matches, const SE3& T_w_b, uint64_t frame_index,
+                                bool create_multiview_points) {
+  const int slot = startKeyframe(map, bridge, frame, T_w_b, frame_index);
+  if (slot < 0) return -1;
   if (matches) {
     for (int c = 0; c < frame.cameras(); ++c) {
       for (int k = 0; k < frame.sets[c].count; ++k) {
@@ -75,28 +81,50 @@ int LocalMapper::insertKeyframe(Map& map, WindowBridge& bridge, const Rig& rig, 
     }
     linkMultiViewPartners(map, rig, slot, frame);
   }
-  if (create_multiview_points) {
-    for (int t = 0; t < frame.mv_count; ++t) {
-      const MultiViewFeature& mv = frame.mv[t];
-      if (!mv.has_point || mv.relative_depth_sigma > options_.landmark_max_depth_sigma) continue;
-      bool linked = false;
-      for (int r = 0; r < mv.size && !linked; ++r) {
-        const KeypointRef& ref = frame.mv_refs[mv.first + r];
-        linked = kf.landmark_of[ref.cam][ref.index] >= 0;
-      }
-      if (linked) continue;
-      const int lm = map.createLandmark(T_w_b * mv.p_b, mv.descriptor, kf.id);
-      if (lm < 0) break;  // map full: keep tracking with what we have
-      map.landmark(lm).metric = true;
-      for (int r = 0; r < mv.size; ++r) {
-        const KeypointRef& ref = frame.mv_refs[mv.first + r];
-        map.addObservation(lm, slot, ref.cam, ref.index);
-      }
-      touch(lm);
-    }
-  }
+  if (create_multiview_points) createMultiViewLandmarks(map, slot, frame);
   finishTouched(map, rig);
   return slot;
+}
+
+int LocalMapper::insertSeededKeyframe(Map& map, WindowBridge& bridge, const Rig& rig, const FrameFeatures& frame,
+                                      std::span<const MapSeed> seeds, const SE3& T_w_b, uint64_t frame_index) {
+  const int slot = startKeyframe(map, bridge, frame, T_w_b, frame_index);
+  if (slot < 0) return -1;
+  const int64_t kf_id = map.keyframe(slot).id;
+  for (const MapSeed& seed : seeds) {
+    if (map.keyframe(slot).landmark_of[seed.cam][seed.kp] >= 0) continue;  // two seeds on one keypoint
+    const int lm = map.createLandmark(seed.p_w, seed.descriptor, kf_id);
+    if (lm < 0) break;
+    map.landmark(lm).metric = seed.metric;
+    map.addObservation(lm, slot, seed.cam, seed.kp);
+    touch(lm);
+  }
+  linkMultiViewPartners(map, rig, slot, frame);
+  createMultiViewLandmarks(map, slot, frame);
+  finishTouched(map, rig);
+  return slot;
+}
+
+void LocalMapper::createMultiViewLandmarks(Map& map, int slot, const FrameFeatures& frame) {
+  Keyframe& kf = map.keyframe(slot);
+  for (int t = 0; t < frame.mv_count; ++t) {
+    const MultiViewFeature& mv = frame.mv[t];
+    if (!mv.has_point || mv.relative_depth_sigma > options_.landmark_max_depth_sigma) continue;
+    bool linked = false;
+    for (int r = 0; r < mv.size && !linked; ++r) {
+      const KeypointRef& ref = frame.mv_refs[mv.first + r];
+      linked = kf.landmark_of[ref.cam][ref.index] >= 0;
+    }
+    if (linked) continue;
+    const int lm = map.createLandmark(kf.T_w_b * mv.p_b, mv.descriptor, kf.id);
+    if (lm < 0) break;  // map full: keep tracking with what we have
+    map.landmark(lm).metric = true;
+    for (int r = 0; r < mv.size; ++r) {
+      const KeypointRef& ref = frame.mv_refs[mv.first + r];
+      map.addObservation(lm, slot, ref.cam, ref.index);
+    }
+    touch(lm);
+  }
 }
 
 // Keypoints of one multi-view feature see the same point: when one of them was matched to a landmark,

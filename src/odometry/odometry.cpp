@@ -23,9 +23,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-// Frames in a row that may fail before the map is dropped and built again.
-constexpr int kMaxLostFrames = 5;
-
 }  // namespace
 
 Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
@@ -77,6 +74,8 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   out.t = frame.t;
   out.sequence = frame_index;
   frame_index_ = frame_index;
+  frame_t_ = frame.t;
+  settled_count_ = 0;
   flush();                                // the previous keyframe's solve, before this frame reads the map
   tracker_->follow(bridge_->rigState());  // a frame boundary: tracking takes the rig state as it is now
   const auto start = Clock::now();
@@ -88,6 +87,14 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
     return;
   }
 
+  if (lost_frames_ > options_.max_lost_frames) {
+    // A loss this long leaves the motion model too far from the truth for tracking to be trusted: only place
+    // memory's relocalization (verified against the place map) brings the frame back, until the timeout starts a
+    // new map.
+    lose(frame_index, 0, out);
+    timing_.tracking_ms = msSince(start);
+    return;
+  }
   SE3 T_w_b;
   int inliers = 0;
   map_.refreshLiveList();  // tracking and the extrinsic check read the live list
@@ -123,14 +130,15 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
 
 void Odometry::lose(uint64_t frame_index, int inliers, PoseEstimate& out) {
   ++stats_.lost;
-  ++lost_frames_;
+  if (lost_frames_++ == 0) lost_since_ = frame_t_;
   spdlog::trace("odometry: frame {}: lost ({} inliers; {} frames in a row)", frame_index, inliers, lost_frames_);
   // Carry on with the motion model so the trajectory stays continuous, and rebuild the map from there when the
   // loss lasts.
   out.T_w_b = tracker_->coast();
   out.state = TrackingState::Lost;
   out.valid = true;
-  if (lost_frames_ > kMaxLostFrames) {
+  const double lost_s = static_cast<double>(frame_t_ - lost_since_) * 1e-9;
+  if (lost_frames_ > options_.max_lost_frames && lost_s >= options_.lost_timeout_s) {
     anchor_ = tracker_->pose();
     initialized_ = false;
     resetMap();
@@ -182,6 +190,7 @@ void Odometry::flush() {
 
 void Odometry::finishKeyframe(int slot) {
   const auto cull_start = Clock::now();
+  noteSettled(slot);
   mapper_->cull(map_, *bridge_, slot, tracker_->landmarkTracks());
   // The back-end moved the keyframe's pose: tracking continues from there.
   tracker_->keyframeSettled(map_, slot);
@@ -251,7 +260,7 @@ int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame
   return kf_new;
 }
 
-void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out) {
+void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out, bool new_map) {
   const int cams = bridge_->rigState().cameras();
   initializer_->reset();
   initialized_ = true;
@@ -262,15 +271,39 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstim
   if (!metric && cams > 1) bridge_->holdScale(true);
   triangulator_->setSceneReferencedPoints(!metric || cams == 1);
   scale_->start(!metric);
-  ++stats_.initializations;
+  if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
   ++stats_.keyframes;
   tracker_->startFrom(map_, kf_new, frame_index);  // from the landmarks of the new keyframe
+  lost_frames_ = 0;
+  for (int k = 0; k < map_.keyframeCapacity(); ++k)
+    if (map_.keyframe(k).alive) noteSettled(k);  // the keyframes of the start are final: solved once
   ++stats_.tracking;
   out.T_w_b = tracker_->pose();
   out.state = TrackingState::Tracking;
   out.valid = true;
   out.is_keyframe = true;
   out.quality = 1.0f;
+}
+
+void Odometry::noteSettled(int slot) {
+  if (settled_count_ < static_cast<int>(settled_.size())) settled_[static_cast<std::size_t>(settled_count_++)] = slot;
+}
+
+void Odometry::relocalize(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b,
+                          std::span<const MapSeed> seeds, PoseEstimate& out) {
+  const ScaleStatus status = bridge_->rigState().scale();
+  settled_count_ = 0;  // the caller took the last frame's before it asked
+  resetMap();
+  anchor_ = T_w_b;
+  const int kf = mapper_->insertSeededKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, seeds, T_w_b,
+                                               frame_index);
+  if (kf < 0) return;
+  bridge_->optimize(map_, kf);
+  ++stats_.relocalizations;
+  out = PoseEstimate{};
+  out.t = frame.t;
+  out.sequence = frame_index;
+  startMap(kf, frame_index, status != ScaleStatus::Unscaled, out, /*new_map=*/false);
 }
 
 }  // namespace mcslam

@@ -1,5 +1,7 @@
 #include "mcslam/pipeline/dataset_frame.hpp"
 
+#include <algorithm>
+
 namespace mcslam {
 
 void DatasetFrame::load(const Dataset& ds, std::size_t i) {
@@ -17,6 +19,11 @@ void DatasetFrame::load(const Dataset& ds, std::size_t i) {
   }
   t_ = ds.frames()[i].t;
   sequence_ = i;
+}
+
+void DatasetFrame::blacken() {
+  for (std::size_t c = 0; c < images_.size(); ++c)
+    if (loaded_[c]) std::fill_n(images_[c].data(), images_[c].width() * images_[c].height(), uint8_t{0});
 }
 
 RigFrameView DatasetFrame::view() const {

@@ -100,6 +100,18 @@ void readBackend(ConfigSection s, PipelineConfig& c) {
   s.finish();
 }
 
+void readPlaces(ConfigSection s, PipelineConfig& c) {
+  PlacesOptions& p = c.places;
+  s.read("enabled", p.enabled);
+  s.read("vocabulary", p.vocabulary);
+  s.read("max_keyframes", p.max_keyframes, 10, 1000000);
+  s.read("max_points_per_keyframe", p.max_points_per_keyframe, 50, 100000);
+  s.read("max_words_per_keyframe", p.max_words_per_keyframe, 50, 1000000);
+  s.read("min_inliers", p.min_inliers, 10, 100000);
+  s.read("relocalization_timeout_s", p.relocalization_timeout_s, 0.0, 3600.0);
+  s.finish();
+}
+
 }  // namespace
 
 const char* refineExtrinsicsName(RefineExtrinsics r) {
@@ -118,7 +130,10 @@ PipelineConfig parsePipelineConfig(const YAML::Node& slam, const std::string& so
   readKeyframes(root.child("keyframes"), c);
   readInitialization(root.child("initialization"), c);
   readBackend(root.child("backend"), c);
+  readPlaces(root.child("places"), c);
   root.finish();
+  // While place memory may find a lost frame, the odometry waits for it before it starts a new map.
+  if (c.places.enabled) c.odometry.lost_timeout_s = c.places.relocalization_timeout_s;
   // One pyramid for extraction, multi-view matching and tracking.
   c.multiview.octave_scale = c.orb.scale_factor;
   c.odometry.scale_factor = c.orb.scale_factor;
@@ -179,7 +194,15 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    thread: " << (o.backend_thread ? "true" : "false") << "\n"
      << "    refine_extrinsics: " << refineExtrinsicsName(c.refine_extrinsics) << "\n"
      << "    extrinsic_sigma_translation: " << o.extrinsic_sigma_translation << "\n"
-     << "    extrinsic_sigma_rotation_deg: " << o.extrinsic_sigma_rotation_deg << "\n";
+     << "    extrinsic_sigma_rotation_deg: " << o.extrinsic_sigma_rotation_deg << "\n"
+     << "  places:\n"
+     << "    enabled: " << (c.places.enabled ? "true" : "false") << "\n"
+     << "    vocabulary: \"" << c.places.vocabulary << "\"\n"
+     << "    max_keyframes: " << c.places.max_keyframes << "\n"
+     << "    max_points_per_keyframe: " << c.places.max_points_per_keyframe << "\n"
+     << "    max_words_per_keyframe: " << c.places.max_words_per_keyframe << "\n"
+     << "    min_inliers: " << c.places.min_inliers << "\n"
+     << "    relocalization_timeout_s: " << c.places.relocalization_timeout_s << "\n";
   return os.str();
 }
 

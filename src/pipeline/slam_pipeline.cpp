@@ -36,6 +36,11 @@ SlamPipeline::SlamPipeline(const Rig& rig, const PipelineConfig& config)
   // Two: one being prepared while the other is finished.
   for (int k = 0; k < 2; ++k) stages_.push_back(Stage{FrameFeatures(rig_.size(), config_.orb.max_features), 0, 0, {}});
   handover_ = effectiveOdometryOptions(config_, front_end_.overlap()).refine_extrinsics && rig_.size() > 1;
+  if (config_.places.enabled) {
+    vocabulary_ = std::make_unique<Vocabulary>(loadVocabulary(config_.places.vocabulary));
+    places_ = std::make_unique<PlaceMemory>(rig_, *vocabulary_, config_.places, config_.odometry,
+                                            config_.orb.max_features);
+  }
   if (handover_) rig_after_.assign(2, RigState(rig_));
 }
 
@@ -56,6 +61,7 @@ void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out
 void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out,
                          PipelineTiming& timing) {
   odometry_.process(features, sequence, out);
+  if (places_) places_->afterOdometry(features, sequence, odometry_, out);
   if (handover_) {
     rig_after_[frames_tracked_ % 2].follow(odometry_.rigState());  // by value, allocates nothing
     ++frames_tracked_;

@@ -5,8 +5,10 @@
 //   | u32 CRC-32 of everything before it
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 
 #include "mcslam/core/checksum.hpp"
@@ -108,6 +110,29 @@ Vocabulary readVocabularyFile(const std::string& path) {
   for (WordId w = 0; w < v.wordCount(); ++w) v.setIdf(w, take<float>(bytes, idf_at));
   if (v.empty()) throw InputError(path + ": the vocabulary has no words");
   return v;
+}
+
+std::vector<std::string> defaultVocabularyCandidates() {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) out.push_back((exe.parent_path() / "../share/mcslam/places" / MCSLAM_VOCABULARY_FILE_NAME).lexically_normal());
+  for (const char* fixed : {MCSLAM_VOCABULARY_SOURCE_PATH, MCSLAM_VOCABULARY_INSTALL_PATH})
+    if (std::find(out.begin(), out.end(), fixed) == out.end()) out.push_back(fixed);
+  return out;
+}
+
+Vocabulary loadVocabulary(const std::string& path) {
+  if (!path.empty()) return readVocabularyFile(path);
+  std::string tried;
+  for (const std::string& candidate : defaultVocabularyCandidates()) {
+    std::error_code ec;
+    if (std::filesystem::exists(candidate, ec)) return readVocabularyFile(candidate);
+    tried += (tried.empty() ? "" : ", ") + candidate;
+  }
+  throw InputError("no vocabulary file: the shipped one is in none of " + tried +
+                   " (give one with places.vocabulary, or turn place memory off with places.enabled: false)");
 }
 
 void writeVocabularyFile(const Vocabulary& v, const std::string& path) {

@@ -28,7 +28,31 @@ struct RunOptions {
   bool quiet = false, print_config = false, overlap = true;
   std::string log_level = "info";
   std::size_t max_frames = 0;
+  std::string black_text, skip_text;  // fault injection: frame ranges "A-B"
 };
+
+// A range of frames "A-B" (both included) or "A"; empty text: none. Throws InputError naming the option.
+struct FrameRange {
+  std::size_t first = 1, last = 0;  // empty
+  bool contains(std::size_t i) const { return i >= first && i <= last; }
+};
+
+FrameRange parseFrameRange(const std::string& option, const std::string& text) {
+  FrameRange r;
+  if (text.empty()) return r;
+  unsigned long long a = 0, b = 0;
+  char dash = 0;
+  char extra = 0;
+  const int n = std::sscanf(text.c_str(), "%llu%c%llu%c", &a, &dash, &b, &extra);
+  if (n == 1) {
+    b = a;
+  } else if (n != 3 || dash != '-' || b < a) {
+    throw InputError(option + " '" + text + "': expected frames A-B with A <= B (or one frame A)");
+  }
+  r.first = static_cast<std::size_t>(a);
+  r.last = static_cast<std::size_t>(b);
+  return r;
+}
 
 void addOptions(CLI::App& app, RunOptions& o) {
   app.add_option("--dataset", o.dataset_dir,
@@ -46,6 +70,11 @@ void addOptions(CLI::App& app, RunOptions& o) {
   app.add_option("--extrinsics", o.extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", o.max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", o.quiet, "No progress bar");
+  app.add_option("--black", o.black_text,
+                 "Fault injection: every camera's image of frames A-B (dataset indices) is black, as if the rig were "
+                 "covered");
+  app.add_option("--skip", o.skip_text,
+                 "Fault injection: frames A-B are never given to the SLAM (a kidnap: the rig moved unseen)");
   app.add_option("--log-level", o.log_level,
                  "Log of the pipeline's events (debug: also each scale estimate of a rig "
                  "without overlap; trace: also every frame's tracking attempts, inliers, "
@@ -75,8 +104,10 @@ YAML::Node slamSection(const std::string& path) {
 // Decodes the dataset's frames one ahead, on a thread of its own: the front-end does not wait for the decoding.
 class FramePrefetch {
  public:
-  FramePrefetch(const Dataset& ds, std::size_t frames) : ds_(ds), frames_(frames) {
-    if (frames_ > 0) next_ = std::async(std::launch::async, load, std::cref(ds_), std::size_t{0});
+  // Runs the dataset's frames `order[0], order[1], ...`; those in `black` become black.
+  FramePrefetch(const Dataset& ds, const std::vector<std::size_t>& order, FrameRange black)
+      : ds_(ds), order_(order), frames_(order.size()), black_(black) {
+    if (frames_ > 0) next_ = std::async(std::launch::async, load, std::cref(ds_), order_[0], black_);
   }
   ~FramePrefetch() {
     if (next_.valid()) next_.wait();
@@ -84,18 +115,21 @@ class FramePrefetch {
   // Frame i (called for i = 0, 1, ... in turn); starts decoding frame i + 1.
   DatasetFrame take(std::size_t i) {
     DatasetFrame f = next_.get();
-    if (i + 1 < frames_) next_ = std::async(std::launch::async, load, std::cref(ds_), i + 1);
+    if (i + 1 < frames_) next_ = std::async(std::launch::async, load, std::cref(ds_), order_[i + 1], black_);
     return f;
   }
 
  private:
-  static DatasetFrame load(const Dataset& ds, std::size_t i) {
+  static DatasetFrame load(const Dataset& ds, std::size_t i, FrameRange black) {
     DatasetFrame f;
     f.load(ds, i);
+    if (black.contains(i)) f.blacken();
     return f;
   }
   const Dataset& ds_;
+  const std::vector<std::size_t>& order_;
   std::size_t frames_;
+  FrameRange black_;
   std::future<DatasetFrame> next_;
 };
 
@@ -151,10 +185,11 @@ struct FrameTag {
 // Runs the first `frames` frames through the pipeline's stages (StageRunner): the front-end of frame i+1 on a
 // thread of its own while frame i is tracked on this one, or, without `overlap`, one after the other on this
 // thread. The stages share no state, so the output is the same either way. Returns the wall time in seconds.
-double runFrames(SlamPipeline& pipeline, const Dataset& ds, std::size_t frames, bool overlap, run::RunReport& report,
-                 Console& console) {
+double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<std::size_t>& order, FrameRange black,
+                 bool overlap, run::RunReport& report, Console& console) {
+  const std::size_t frames = order.size();
   StageRunner<FrameTag> runner(pipeline);
-  FramePrefetch prefetch(ds, frames);
+  FramePrefetch prefetch(ds, order, black);
   auto prepare = [&](std::size_t i) {
     const DatasetFrame f = prefetch.take(i);
     runner.prepare(f.view(), FrameTag{f.error()});
@@ -233,13 +268,18 @@ int runDataset(const RunOptions& o) {
   }
   SlamPipeline pipeline(ds.rig(), config);
   const std::size_t frames = o.max_frames > 0 ? std::min(o.max_frames, ds.size()) : ds.size();
+  const FrameRange black = parseFrameRange("--black", o.black_text);
+  const FrameRange skip = parseFrameRange("--skip", o.skip_text);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < frames; ++i)
+    if (!skip.contains(i)) order.push_back(i);
   if (!o.quiet) {
     std::fprintf(stderr, "mcslam-run: %s (%s), %d camera%s, %zu frames\n", o.dataset_dir.c_str(), ds.format().c_str(),
                  ds.rig().size(), ds.rig().size() == 1 ? "" : "s", frames);
   }
   run::RunReport report;
-  Console console(o.quiet, frames);
-  const double wall = runFrames(pipeline, ds, frames, o.overlap, report, console);
+  Console console(o.quiet, order.size());
+  const double wall = runFrames(pipeline, ds, order, black, o.overlap, report, console);
   if (!o.out_path.empty()) writeTumTrajectory(o.out_path, report.trajectory());
   if (!o.keyframes_path.empty()) writeTumTrajectory(o.keyframes_path, report.keyframes());
   if (!o.stats_path.empty()) report.writeStats(o.stats_path, pipeline, o.dataset_dir, ds.rig().size(), wall);

@@ -135,6 +135,17 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("recoveries").value(s.recoveries);
   j.key("extrinsic_reestimations").value(s.extrinsic_reestimations);
   j.key("rejected_images").value(pipeline.rejectedImages());
+  if (const PlaceMemory* places = pipeline.places()) {
+    const PlaceStats& p = places->stats();
+    j.key("places").beginObject();
+    j.key("keyframes").value(p.keyframes);
+    j.key("keyframes_dropped").value(p.keyframes_dropped);
+    j.key("relocalization_queries").value(p.relocalization_queries);
+    j.key("relocalizations").value(p.relocalizations);
+    j.key("segments").value(p.segments);
+    j.key("last_relocalized_frame").value(static_cast<long long>(p.last_relocalized_frame));
+    j.endObject();
+  }
   j.key("timing_ms").beginObject();
   const std::pair<const char*, Summary> stages[] = {{"feature_extraction", summarize(features)},
                                                     {"tracking_and_mapping", summarize(tracking)},

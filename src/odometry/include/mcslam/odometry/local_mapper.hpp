@@ -11,6 +11,7 @@
 #include "mcslam/features/octave_scales.hpp"
 #include "mcslam/odometry/landmark_tracks.hpp"
 #include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/map_seed.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/projection_search.hpp"
 
@@ -29,6 +30,10 @@ class LocalMapper {
   int insertKeyframe(Map& map, WindowBridge& bridge, const Rig& rig, const FrameFeatures& frame,
                      const FrameMatches* matches, const SE3& T_w_b, uint64_t frame_index,
                      bool create_multiview_points = true);
+  // Inserts the frame as the first keyframe of a map seeded with known points (relocalization): each seed becomes a
+  // landmark observed by its keypoint, then multi-view features as in insertKeyframe().
+  int insertSeededKeyframe(Map& map, WindowBridge& bridge, const Rig& rig, const FrameFeatures& frame,
+                           std::span<const MapSeed> seeds, const SE3& T_w_b, uint64_t frame_index);
   // Recomputes the representative descriptor and distance range of new landmarks (TemporalTriangulator's);
   // with `now` false, at the end of the next keyframe insertion instead.
   void updateAppearance(Map& map, const Rig& rig, std::span<const int32_t> landmarks, bool now);
@@ -39,6 +44,10 @@ class LocalMapper {
 
  private:
   int allocateKeyframe(Map& map, WindowBridge& bridge);
+  // A keyframe slot holding the frame at T_w_b, without observations yet.
+  int startKeyframe(Map& map, WindowBridge& bridge, const FrameFeatures& frame, const SE3& T_w_b, uint64_t frame_index);
+  // Metric multi-view features none of whose keypoints observes a landmark become landmarks.
+  void createMultiViewLandmarks(Map& map, int slot, const FrameFeatures& frame);
   void linkMultiViewPartners(Map& map, const Rig& rig, int slot, const FrameFeatures& frame);
   void touch(int lm);
   void finishTouched(Map& map, const Rig& rig);

@@ -3,11 +3,14 @@
 // of every frame against the local map, keyframes, new landmarks from multi-view features and from
 // rays of different cameras and times, and the sliding-window back-end. Works for one camera, for
 // overlapping and for non-overlapping rigs alike. All memory is allocated at construction.
+#include <array>
 #include <cmath>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "mcslam/odometry/map.hpp"
+#include "mcslam/odometry/map_seed.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/pose_estimate.hpp"
 #include "mcslam/odometry/rig_state.hpp"
@@ -23,6 +26,7 @@ struct OdometryStats {
   uint64_t initializations = 0;
   uint64_t keyframes = 0;
   uint64_t recoveries = 0;  // frames tracked only through the descriptor fallback
+  uint64_t relocalizations = 0;  // lost frames the place map found (relocalize())
   uint64_t backend_solves = 0;
   uint64_t extrinsic_reestimations = 0;  // cameras whose extrinsic the per-camera check replaced
   double last_backend_ms = 0;
@@ -64,6 +68,17 @@ class Odometry {
   // process() does it first thing; call it after the last frame, before reading the map's final keyframes.
   void flush();
 
+  // The frame was lost and place memory found it at T_w_b (this odometry's frame) with the place map's points
+  // matched to its keypoints: the local map starts again there, from those points and the frame's own multi-view
+  // features, in the same frame and unit. `out` becomes the frame's tracked estimate.
+  void relocalize(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, std::span<const MapSeed> seeds,
+                  PoseEstimate& out);
+  // Keyframes (slots) that became final in the last process() or relocalize(): solved by the back-end and culled,
+  // or the first keyframes of a new map. Valid until the next call.
+  std::span<const int32_t> settledKeyframes() const {
+    return {settled_.data(), static_cast<std::size_t>(settled_count_)};
+  }
+
   const OdometryStats& stats() const { return stats_; }
   const OdometryTiming& timing() const { return timing_; }
   const Map& map() const { return map_; }
@@ -90,7 +105,7 @@ class Odometry {
   int initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_index);  // keyframe slot, -1: not yet
   int initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, bool& metric);
   // The map starts at keyframe `kf_new`: the track state.
-  void startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out);
+  void startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out, bool new_map = true);
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.
   void lose(uint64_t frame_index, int inliers, PoseEstimate& out);
@@ -98,7 +113,8 @@ class Odometry {
   void makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers, PoseEstimate& out);
   // New landmarks across time for keyframe `slot` (TemporalTriangulator); returns how many.
   int triangulateNew(int slot);
-  void finishKeyframe(int slot);  // culling and the state that follows the (optimized) keyframe pose
+  void finishKeyframe(int slot);
+  void noteSettled(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
   void clearMap();  // the map, the mapper's pending work and the window
   // At a settled keyframe of a map started up to scale: the map, the window and the motion model take the unit
@@ -119,6 +135,10 @@ class Odometry {
   SE3 anchor_;                 // pose given to the next initialization (continuity after a loss)
   int pending_keyframe_ = -1;  // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
+  Timestamp lost_since_ = 0;  // capture time of the first frame of the loss
+  Timestamp frame_t_ = 0;     // of the frame being processed
+  std::array<int32_t, 4> settled_{};
+  int settled_count_ = 0;
   int64_t last_init_reference_ = -1;
   uint64_t frame_index_ = 0;  // of the frame being processed
   OdometryStats stats_;

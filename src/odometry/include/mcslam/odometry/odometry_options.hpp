@@ -25,6 +25,11 @@ struct OdometryOptions {
   int min_tracked = 12;                 // fewer inliers after refinement: the frame is lost
   double strong_tracking_share = 0.25;  // a coarse pose is trusted with this share of the previous frame's inliers
 
+  // Tracking loss: the map is dropped and a new one started once this many frames in a row failed and, when place
+  // memory may relocalize the rig meanwhile (PlacesOptions::relocalization_timeout_s), this long has passed.
+  int max_lost_frames = 5;
+  double lost_timeout_s = 0;
+
   // Keyframes.
   double keyframe_tracked_ratio =
       0.75;                       // new keyframe when tracked landmarks fall below this share of the last keyframe's

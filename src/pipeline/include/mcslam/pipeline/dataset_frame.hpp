@@ -17,6 +17,8 @@ class DatasetFrame {
   // Valid until the next load() (and across a move: it points into this object's heap buffers).
   RigFrameView view() const;
   const std::string& error() const { return error_; }
+  // Every loaded image becomes black (fault injection: a covered or dark rig; the cameras stay present).
+  void blacken();
 
  private:
   std::vector<Image> images_;

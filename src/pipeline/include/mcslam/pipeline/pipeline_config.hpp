@@ -11,6 +11,7 @@
 #include "mcslam/features/orb_extractor.hpp"
 #include "mcslam/features/overlap_map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
+#include "mcslam/places/places_options.hpp"
 
 namespace mcslam {
 
@@ -30,6 +31,7 @@ struct PipelineConfig {
   MultiViewOptions multiview;
   OdometryOptions odometry;
   RefineExtrinsics refine_extrinsics = RefineExtrinsics::Auto;
+  PlacesOptions places;
 };
 
 // Defaults for `rig`, overridden by `slam` (may be null). Throws InputError naming `source` and the key.

@@ -1,8 +1,10 @@
 #pragma once
 // The whole SLAM pipeline behind the FrameProcessor boundary: front-end, odometry and back-end.
+#include <memory>
 #include <vector>
 
 #include "mcslam/odometry/odometry.hpp"
+#include "mcslam/places/place_memory.hpp"
 #include "mcslam/pipeline/front_end.hpp"
 
 namespace mcslam {
@@ -38,6 +40,8 @@ class SlamPipeline final : public FrameProcessor {
   // Read on the thread that finishes the frames, between frames.
   const PipelineTiming& timing() const { return timing_; }  // of the last finished frame
   const OdometryStats& stats() const { return odometry_.stats(); }
+  // Place memory; nullptr when the configuration turns it off.
+  const PlaceMemory* places() const { return places_.get(); }
   uint64_t rejectedImages() const { return front_end_.rejectedImages(); }
   int cameras() const { return rig_.size(); }
   bool initialized() const { return odometry_.initialized(); }
@@ -63,6 +67,8 @@ class SlamPipeline final : public FrameProcessor {
   PipelineConfig config_;
   FrontEnd front_end_;
   Odometry odometry_;
+  std::unique_ptr<Vocabulary> vocabulary_;
+  std::unique_ptr<PlaceMemory> places_;
   FrameFeatures features_;
   PipelineTiming timing_;
   struct Stage {

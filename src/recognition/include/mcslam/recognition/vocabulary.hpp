@@ -63,6 +63,12 @@ class Vocabulary {
 // The vocabulary file: versioned binary with a checksum. Throws InputError naming the file and what is wrong with
 // it (missing, not a vocabulary, another version, a shape outside the limits, truncated, corrupt).
 Vocabulary readVocabularyFile(const std::string& path);
+// Where the shipped vocabulary is looked for, in order: beside the executable (../share/mcslam/places/), the
+// source tree's config/places/, the install folder.
+std::vector<std::string> defaultVocabularyCandidates();
+// `path`, or with an empty path the first default candidate that exists. Throws InputError (naming every path
+// tried when none exists).
+Vocabulary loadVocabulary(const std::string& path);
 // Written whole or not at all (writeFileSynced). Throws InputError naming the file when it cannot.
 void writeVocabularyFile(const Vocabulary& vocabulary, const std::string& path);
 

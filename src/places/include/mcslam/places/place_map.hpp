@@ -1,0 +1,92 @@
+#pragma once
+// The place map: the map of the robot's whole life, in fixed memory. A pool of place keyframes, each with its world
+// pose, the odometry pose it was made at and its segment, and its points anchored in its own body frame (position,
+// descriptor, camera, the vocabulary node the descriptor falls in, the odometry's landmark id); points are kept
+// sorted by node, so that matching a frame against a keyframe compares only descriptors of the same node. A
+// segment is a stretch of odometry in one frame `o`; the map knows each segment's T_w_o. Slots are recycled, ids
+// never. Nothing is allocated after construction.
+//
+// One writer: PlaceMemory (and the map file reader). Readers get const views for a call.
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mcslam/core/se3.hpp"
+#include "mcslam/core/time.hpp"
+#include "mcslam/features/keypoint.hpp"
+#include "mcslam/places/places_options.hpp"
+
+namespace mcslam {
+
+struct PlacePoint {
+  Eigen::Vector3f p_k = Eigen::Vector3f::Zero();  // in the keyframe's body frame
+  int32_t node = 0;                               // vocabulary node of the descriptor (FrameWords::node)
+  int16_t cam = -1;                               // camera of the keyframe that observed it
+  int8_t octave = 0;
+  int64_t landmark_id = -1;  // the odometry's landmark (ids are unique over the run)
+  Descriptor descriptor{};
+};
+
+struct PlaceKeyframe {
+  bool alive = false;
+  int64_t id = -1;
+  int32_t segment = -1;
+  Timestamp t = 0;
+  uint64_t frame_index = 0;
+  SE3 T_w_k;  // world pose (moved by loop closures)
+  SE3 T_o_k;  // pose in its segment's odometry frame when it was made
+  int32_t previous = -1, next = -1;  // neighbours in its segment (slots)
+  int32_t point_count = 0;
+};
+
+class PlaceMap {
+ public:
+  static constexpr int kMaxSegments = 256;
+
+  PlaceMap(int max_keyframes, int max_points_per_keyframe);
+
+  void clear();
+  int capacity() const { return static_cast<int>(keyframes_.size()); }
+  int maxPointsPerKeyframe() const { return max_points_; }
+  int size() const { return live_; }
+
+  // A new keyframe at the end of `segment` (slot, or -1 when the pool is full). Its points are added with
+  // addPoint() and then sorted by finishKeyframe().
+  int createKeyframe(int32_t segment, Timestamp t, uint64_t frame_index, const SE3& T_w_k, const SE3& T_o_k);
+  bool addPoint(int slot, const PlacePoint& point);  // false when the keyframe holds its maximum
+  void finishKeyframe(int slot);
+  void eraseKeyframe(int slot);  // its neighbours become each other's
+
+  const PlaceKeyframe& keyframe(int slot) const { return keyframes_[static_cast<std::size_t>(slot)]; }
+  void setKeyframePose(int slot, const SE3& T_w_k) { keyframes_[static_cast<std::size_t>(slot)].T_w_k = T_w_k; }
+  std::span<const PlacePoint> points(int slot) const {
+    return {points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_),
+            static_cast<std::size_t>(keyframes_[static_cast<std::size_t>(slot)].point_count)};
+  }
+  // Points of keyframe `slot` whose node is `node` (they are contiguous).
+  std::span<const PlacePoint> pointsOfNode(int slot, int32_t node) const;
+  int newestKeyframe() const { return newest_; }  // slot, -1 when empty
+
+  // Segments: T_w_o of each, and whether it is known in the world (the first segment is; one started after a loss
+  // that relocalization could not bridge is not, until a recognition joins it).
+  int32_t createSegment(const SE3& T_w_o);  // -1 when there are kMaxSegments
+  int segments() const { return segment_count_; }
+  const SE3& segmentPose(int32_t segment) const { return segment_T_w_o_[static_cast<std::size_t>(segment)]; }
+  void setSegmentPose(int32_t segment, const SE3& T_w_o) { segment_T_w_o_[static_cast<std::size_t>(segment)] = T_w_o; }
+
+ private:
+  std::vector<PlaceKeyframe> keyframes_;
+  std::vector<PlacePoint> points_;  // max_points_ per keyframe slot
+  std::vector<int32_t> free_;
+  int free_count_ = 0;
+  int live_ = 0;
+  int max_points_ = 0;
+  int newest_ = -1;
+  int64_t next_id_ = 0;
+  std::vector<int32_t> newest_of_segment_;
+  std::vector<SE3> segment_T_w_o_;
+  int segment_count_ = 0;
+};
+
+}  // namespace mcslam

@@ -1,0 +1,206 @@
+#include "mcslam/places/relocalizer.hpp"
+
+#include <climits>
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+namespace mcslam {
+
+namespace {
+
+// A RANSAC consensus only proposes a pose: the guided search and min_inliers decide.
+constexpr int kRansacMinInliers = 12;
+constexpr int kGridCell = 32;
+constexpr double kSearchRadiusPx = 8.0;  // at octave 0, around the projection (ORB-SLAM's relocalization: 10)
+
+AbsolutePoseRansacOptions ransacOptions() {
+  AbsolutePoseRansacOptions r;
+  r.max_iterations = 300;
+  r.min_inliers = kRansacMinInliers;
+  r.seed = 7;
+  return r;
+}
+
+}  // namespace
+
+Relocalizer::Relocalizer(const Rig& rig, const PlacesOptions& options, float scale_factor,
+                         int max_features_per_camera)
+    : rig_(rig),
+      options_(options),
+      candidates_(static_cast<std::size_t>(options.max_candidates)),
+      group_(static_cast<std::size_t>(2 * options.neighbour_keyframes + 1)),
+      matches_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
+      observations_(matches_.size()),
+      inliers_(matches_.size()),
+      ransac_(rig, rig.size() * max_features_per_camera, ransacOptions()),
+      refiner_(rig, rig.size() * max_features_per_camera) {
+  for (int o = 0; o < 32; ++o) octave_sigma_.push_back(std::pow(scale_factor, static_cast<float>(o)));
+  const auto per_camera = static_cast<std::size_t>(max_features_per_camera);
+  for (int c = 0; c < rig.size(); ++c) {
+    grids_.emplace_back(rig.model(c).width(), rig.model(c).height(), kGridCell, max_features_per_camera);
+    best_distance_.emplace_back(per_camera, 0);
+    best_point_.emplace_back(per_camera, nullptr);
+    best_keyframe_.emplace_back(per_camera, -1);
+  }
+}
+
+void Relocalizer::prepareFrame(const FrameFeatures& frame) {
+  for (int c = 0; c < frame.cameras(); ++c)
+    if (frame.present[static_cast<std::size_t>(c)]) grids_[static_cast<std::size_t>(c)].build(frame.sets[static_cast<std::size_t>(c)]);
+}
+
+int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& map, const SE3& T_w_b) {
+  const int cams = frame.cameras();
+  for (int c = 0; c < cams; ++c)
+    std::fill_n(best_point_[static_cast<std::size_t>(c)].begin(), frame.sets[static_cast<std::size_t>(c)].count,
+                nullptr);
+  for (int c = 0; c < cams; ++c) {
+    if (!frame.present[static_cast<std::size_t>(c)]) continue;
+    const SE3 T_c_w = (T_w_b * rig_.T_b_c(c)).inverse();
+    const CameraModel& model = rig_.model(c);
+    const FeatureSet& set = frame.sets[static_cast<std::size_t>(c)];
+    auto& best_distance = best_distance_[static_cast<std::size_t>(c)];
+    auto& best_point = best_point_[static_cast<std::size_t>(c)];
+    auto& best_keyframe = best_keyframe_[static_cast<std::size_t>(c)];
+    for (int g = 0; g < group_count_; ++g) {
+      const int kf = group_[static_cast<std::size_t>(g)];
+      const SE3 T_c_k = T_c_w * map.keyframe(kf).T_w_k;
+      for (const PlacePoint& p : map.points(kf)) {
+        const Vec3 p_c = T_c_k * p.p_k.cast<double>();
+        Vec2 uv;
+        if (p_c.z() <= 0 || !model.project(p_c, uv) || !model.inImage(uv, 0)) continue;
+        const double radius = kSearchRadiusPx * octave_sigma_[static_cast<std::size_t>(std::clamp<int>(p.octave, 0, 31))];
+        grids_[static_cast<std::size_t>(c)].forEachNear(uv.x(), uv.y(), radius, [&](const KeypointGrid::Entry& e) {
+          if ((Vec2(e.x, e.y) - uv).squaredNorm() > radius * radius) return;
+          const int d = hammingDistance(p.descriptor, set.descriptors[static_cast<std::size_t>(e.index)]);
+          if (d > options_.max_hamming) return;
+          const auto k = static_cast<std::size_t>(e.index);
+          if (!best_point[k] || d < best_distance[k]) {
+            best_point[k] = &p;
+            best_distance[k] = d;
+            best_keyframe[k] = kf;
+          }
+        });
+      }
+    }
+  }
+  int count = 0;
+  for (int c = 0; c < cams; ++c) {
+    if (!frame.present[static_cast<std::size_t>(c)]) continue;
+    const FeatureSet& set = frame.sets[static_cast<std::size_t>(c)];
+    for (int k = 0; k < set.count; ++k) {
+      const PlacePoint* p = best_point_[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)];
+      if (!p || !frame.valid[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)]) continue;
+      const int kf = best_keyframe_[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)];
+      addMatch(frame, map, c, k, p, kf, count);
+    }
+  }
+  return count;
+}
+
+void Relocalizer::addMatch(const FrameFeatures& frame, const PlaceMap& map, int c, int k, const PlacePoint* point,
+                           int keyframe, int& count) {
+  const Keypoint& kp = frame.sets[static_cast<std::size_t>(c)].keypoints[static_cast<std::size_t>(k)];
+  const Vec3 p_w = map.keyframe(keyframe).T_w_k * point->p_k.cast<double>();
+  matches_[static_cast<std::size_t>(count)] = {static_cast<int16_t>(c), k, p_w, point};
+  observations_[static_cast<std::size_t>(count)] =
+      makePoseObservation(rig_, c, Vec2(kp.x, kp.y), frame.bearings[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)],
+                          p_w, octave_sigma_[static_cast<std::size_t>(std::clamp<int>(kp.octave, 0, 31))]);
+  ++count;
+}
+
+void Relocalizer::setRig(const Rig& rig) {
+  for (int c = 0; c < rig.size(); ++c) {
+    rig_.cameras[static_cast<std::size_t>(c)].T_b_c = rig.T_b_c(c);
+    ransac_.setExtrinsic(c, rig.T_b_c(c));
+    refiner_.setExtrinsic(c, rig.T_b_c(c));
+  }
+}
+
+int Relocalizer::gatherGroup(const PlaceMap& map, int keyframe) {
+  group_count_ = 0;
+  group_[static_cast<std::size_t>(group_count_++)] = keyframe;
+  int before = map.keyframe(keyframe).previous, after = map.keyframe(keyframe).next;
+  for (int i = 0; i < options_.neighbour_keyframes; ++i) {
+    if (before >= 0) {
+      group_[static_cast<std::size_t>(group_count_++)] = before;
+      before = map.keyframe(before).previous;
+    }
+    if (after >= 0) {
+      group_[static_cast<std::size_t>(group_count_++)] = after;
+      after = map.keyframe(after).next;
+    }
+  }
+  return group_count_;
+}
+
+int Relocalizer::match(const FrameFeatures& frame, const FrameWords& words, const PlaceMap& map) {
+  int count = 0;
+  for (int c = 0; c < frame.cameras(); ++c) {
+    if (!frame.present[static_cast<std::size_t>(c)]) continue;
+    const FeatureSet& set = frame.sets[static_cast<std::size_t>(c)];
+    for (int k = 0; k < set.count; ++k) {
+      if (!frame.valid[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)]) continue;
+      const Descriptor& d = set.descriptors[static_cast<std::size_t>(k)];
+      const int32_t node = words.node(c, k);
+      int best = INT_MAX, second = INT_MAX, best_keyframe = -1;
+      const PlacePoint* best_point = nullptr;
+      for (int g = 0; g < group_count_; ++g) {
+        for (const PlacePoint& p : map.pointsOfNode(group_[static_cast<std::size_t>(g)], node)) {
+          const int distance = hammingDistance(d, p.descriptor);
+          if (best_point && p.landmark_id == best_point->landmark_id) {
+            best = std::min(best, distance);  // the same landmark in another keyframe: no rival
+            continue;
+          }
+          if (distance < best) {
+            second = best;
+            best = distance;
+            best_point = &p;
+            best_keyframe = group_[static_cast<std::size_t>(g)];
+          } else if (distance < second) {
+            second = distance;
+          }
+        }
+      }
+      if (!best_point || best > options_.max_hamming || !passesRatioTest(best, second, options_.match_ratio)) continue;
+      addMatch(frame, map, c, k, best_point, best_keyframe, count);
+    }
+  }
+  return count;
+}
+
+bool Relocalizer::verify(const FrameFeatures& frame, const FrameWords& words, const PlaceMap& map, int keyframe,
+                         RelocalizationResult& result) {
+  gatherGroup(map, keyframe);
+  const int matched = match(frame, words, map);
+  if (matched < kRansacMinInliers) return false;
+  const AbsolutePoseRansacResult r =
+      ransac_.estimate(std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(matched)));
+  if (!r.ok()) return false;
+  // The consensus may be repeated texture: the pose must find its points where they project.
+  const int projected = searchByProjection(frame, map, r.T_w_b);
+  const PoseRefinementResult refined =
+      refiner_.refine(std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(projected)), r.T_w_b);
+  spdlog::debug("relocalizer: keyframe {} (group {}): {} matches, {} RANSAC inliers, {} by projection, {} inliers",
+                map.keyframe(keyframe).id, group_count_, matched, r.num_inliers, projected, refined.num_inliers);
+  // A right pose explains most of what it projects onto similar keypoints, and a good part of the frame; a pose
+  // aliased by repeated texture only the aliased part (ORB-SLAM asks 50 inliers of 1000 features: the same share of
+  // the whole rig's keypoints here).
+  const double inliers = refined.num_inliers;
+  if (!refined.success || refined.num_inliers < options_.min_inliers ||
+      inliers < options_.min_inlier_share * static_cast<double>(projected) ||
+      inliers < options_.min_frame_share * static_cast<double>(frame.keypointCount()))
+    return false;
+  inlier_count_ = 0;
+  for (int i = 0; i < projected; ++i)
+    if (refined.inlier_mask[static_cast<std::size_t>(i)])
+      inliers_[static_cast<std::size_t>(inlier_count_++)] = matches_[static_cast<std::size_t>(i)];
+  result.ok = true;
+  result.T_w_b = refined.T_w_b;
+  result.keyframe = keyframe;
+  result.inliers = refined.num_inliers;
+  return true;
+}
+
+}  // namespace mcslam

@@ -1,0 +1,74 @@
+// The place map: keyframes chained per segment, points sorted by vocabulary node, slots recycled and ids not,
+// capacity honoured, nothing allocated after construction.
+#include <gtest/gtest.h>
+
+#include "alloc_testing.hpp"
+#include "mcslam/places/place_map.hpp"
+
+namespace mcslam {
+namespace {
+
+PlacePoint pointAt(int32_t node, int64_t landmark) {
+  PlacePoint p;
+  p.node = node;
+  p.landmark_id = landmark;
+  p.p_k = Eigen::Vector3f(static_cast<float>(node), 0, 1);
+  return p;
+}
+
+TEST(PlaceMap, KeyframesChainWithinTheirSegment) {
+  PlaceMap map(8, 10);
+  const int32_t s0 = map.createSegment(SE3());
+  const int32_t s1 = map.createSegment(SE3(Mat3::Identity(), Vec3(1, 2, 3)));
+  const int a = map.createKeyframe(s0, 1, 1, SE3(), SE3());
+  const int b = map.createKeyframe(s1, 2, 2, SE3(), SE3());
+  const int c = map.createKeyframe(s0, 3, 3, SE3(), SE3());
+  EXPECT_EQ(map.keyframe(a).next, c);
+  EXPECT_EQ(map.keyframe(c).previous, a);
+  EXPECT_EQ(map.keyframe(b).previous, -1);
+  EXPECT_EQ(map.keyframe(b).next, -1);
+  EXPECT_EQ(map.segmentPose(s1).t, Vec3(1, 2, 3));
+  EXPECT_EQ(map.newestKeyframe(), c);
+  map.eraseKeyframe(c);
+  EXPECT_EQ(map.keyframe(a).next, -1);
+  EXPECT_EQ(map.newestKeyframe(), a);
+  const int d = map.createKeyframe(s0, 4, 4, SE3(), SE3());
+  EXPECT_EQ(d, c);  // the slot is recycled ...
+  EXPECT_GT(map.keyframe(d).id, map.keyframe(b).id);  // ... the id is not
+  EXPECT_EQ(map.keyframe(a).next, d);
+  EXPECT_EQ(map.size(), 3);
+}
+
+TEST(PlaceMap, PointsAreFoundByTheirNode) {
+  PlaceMap map(2, 6);
+  const int k = map.createKeyframe(map.createSegment(SE3()), 0, 0, SE3(), SE3());
+  for (int32_t node : {7, 3, 7, 1, 3, 9}) EXPECT_TRUE(map.addPoint(k, pointAt(node, node * 10)));
+  EXPECT_FALSE(map.addPoint(k, pointAt(2, 0)));  // full
+  map.finishKeyframe(k);
+  EXPECT_EQ(map.pointsOfNode(k, 7).size(), 2u);
+  EXPECT_EQ(map.pointsOfNode(k, 3).size(), 2u);
+  EXPECT_EQ(map.pointsOfNode(k, 9).size(), 1u);
+  EXPECT_EQ(map.pointsOfNode(k, 4).size(), 0u);
+  EXPECT_EQ(map.pointsOfNode(k, 10).size(), 0u);
+  for (const PlacePoint& p : map.pointsOfNode(k, 3)) EXPECT_EQ(p.node, 3);
+}
+
+TEST(PlaceMap, AFullMapRefusesAKeyframeAndAllocatesNothing) {
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
+  PlaceMap map(3, 4);
+  alloc::ThreadScope scope;
+  const int32_t s = map.createSegment(SE3());
+  for (int i = 0; i < 3; ++i) {
+    const int k = map.createKeyframe(s, i, static_cast<uint64_t>(i), SE3(), SE3());
+    ASSERT_GE(k, 0);
+    for (int j = 0; j < 4; ++j) map.addPoint(k, pointAt(4 - j, j));
+    map.finishKeyframe(k);
+  }
+  EXPECT_EQ(map.createKeyframe(s, 9, 9, SE3(), SE3()), -1);
+  map.eraseKeyframe(1);
+  EXPECT_EQ(map.createKeyframe(s, 9, 9, SE3(), SE3()), 1);
+  EXPECT_EQ(scope.count(), 0u);
+}
+
+}  // namespace
+}  // namespace mcslam

@@ -1,0 +1,85 @@
+// Relocalization end to end: a 5-camera rig drives the start of the indoor loop (mcslam-sim); mcslam-run blacks
+// out every camera for 2 s. On a straight stretch the rig is found again within 5 frames after the images return,
+// in the same frame (one alignment over the whole run: ATE of the frames with images within 1.5x of the run
+// without the blackout). During a turn into a room never seen, nothing may be found: no relocalization, and a new
+// map after the timeout.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "mcslam/dataset/trajectory.hpp"
+#include "mcslam/eval/trajectory_metrics.hpp"
+#include "test_support.hpp"
+
+namespace mcslam {
+namespace {
+
+constexpr int kFrames = 200;  // 10 Hz: 10 m straight, a stop, a 90-degree turn, 3 m along the next corridor
+
+long jsonInt(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\":");
+  return at == std::string::npos ? -1000 : std::stol(json.substr(at + key.size() + 3));
+}
+
+class Relocalization : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>("relocalization");
+    std::string out;
+    const int code = test::runCommand(test::binPath("mcslam-sim") + " --rig isec --cameras 0,1,2,3,4 --world indoor " +
+                                          "--frames " + std::to_string(kFrames) + " --no-depth --quiet --out " +
+                                          dir_->file("seq"),
+                                      &out);
+    ASSERT_EQ(code, 0) << out;
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+
+  struct Run {
+    Trajectory trajectory;
+    std::string stats;
+    double ate = 0;
+  };
+  // `lost` frames (black: no pose can be measured) are left out of the ATE.
+  static Run run(const std::string& tag, const std::string& faults, int lost_first = 1, int lost_last = 0) {
+    Run r;
+    std::string out;
+    const std::string traj = dir_->file(tag + ".tum"), stats = dir_->file(tag + ".json");
+    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") +
+                                   " --quiet --out " + traj + " --stats " + stats + " " + faults,
+                               &out),
+              0)
+        << out;
+    r.trajectory = readTumTrajectory(traj);
+    Trajectory measured;
+    for (std::size_t i = 0; i < r.trajectory.size(); ++i)
+      if (static_cast<int>(i) < lost_first || static_cast<int>(i) > lost_last) measured.push_back(r.trajectory[i]);
+    r.stats = test::readFile(stats);
+    const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+    r.ate = computeApe(gt, measured, EvalOptions{}).stats.rmse;
+    return r;
+  }
+
+  static std::unique_ptr<test::TempDir> dir_;
+};
+
+std::unique_ptr<test::TempDir> Relocalization::dir_;
+
+TEST_F(Relocalization, AfterABlackoutOnAStraightTheRigIsFoundInTheSameFrame) {
+  const Run plain = run("plain", "");
+  const Run black = run("black", "--black 60-79", 60, 79);
+  EXPECT_EQ(jsonInt(black.stats, "relocalizations"), 1) << black.stats;
+  const long frame = jsonInt(black.stats, "last_relocalized_frame");
+  EXPECT_GE(frame, 80);
+  EXPECT_LT(frame, 85);  // within 5 frames of the images' return
+  EXPECT_EQ(jsonInt(black.stats, "segments"), 1);
+  EXPECT_LT(black.ate, 1.5 * plain.ate) << "plain " << plain.ate;
+}
+
+TEST_F(Relocalization, ABlackoutIntoAnUnseenRoomFindsNothingAndStartsANewMap) {
+  const Run black = run("turn", "--black 150-169");
+  EXPECT_EQ(jsonInt(black.stats, "relocalizations"), 0) << black.stats;
+  EXPECT_EQ(jsonInt(black.stats, "segments"), 2);
+}
+
+}  // namespace
+}  // namespace mcslam
