@@ -29,7 +29,7 @@ def decode(data):
     if len(data) < SIZE:
         raise ValueError("too short (%d bytes)" % len(data))
     (magic, version, size, sequence, frame_sequence, capture_ns, publish_ns,
-     px, py, pz, qx, qy, qz, qw, state, flags, _reserved, quality) = RECORD.unpack_from(data)
+     px, py, pz, qx, qy, qz, qw, state, flags, world_revision, quality) = RECORD.unpack_from(data)
     if magic != MAGIC:
         raise ValueError("bad magic %r" % magic)
     if version != VERSION:
@@ -43,7 +43,7 @@ def decode(data):
         "tracking": TRACKING.get(state, "unknown"),
         "valid": bool(flags & FLAG_VALID), "keyframe": bool(flags & FLAG_KEYFRAME),
         "unscaled": bool(flags & FLAG_UNSCALED),
-        "quality": quality,
+        "quality": quality, "world_revision": world_revision,
     }
 
 

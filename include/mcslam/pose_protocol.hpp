@@ -33,6 +33,10 @@ struct PoseRecord {
   Tracking tracking = Tracking::NotInitialized;
   uint8_t flags = 0;
   float quality = 0;  // 0..1
+  // Times the world estimate has moved (loop closures, map merges), modulo 2^16. When it changes between two
+  // records, the jump between them is a correction of the world, not motion. Readers before it was defined read
+  // 0 here (it was a reserved field) and see only the jump.
+  uint16_t world_revision = 0;
 
   bool valid() const { return (flags & kFlagValid) != 0; }
   bool keyframe() const { return (flags & kFlagKeyframe) != 0; }
@@ -103,7 +107,7 @@ inline float getF32(const uint8_t* p) {
 namespace offset {
 inline constexpr std::size_t kMagic = 0, kVersion = 4, kSize = 6, kSequence = 8, kFrameSequence = 16, kCaptureTime = 24,
                              kPublishTime = 32, kPosition = 40, kOrientation = 64, kTracking = 96, kFlags = 97,
-                             kReserved = 98, kQuality = 100;
+                             kWorldRevision = 98, kQuality = 100;
 }
 
 inline void encodePacket(const PoseRecord& r, uint8_t out[kPacketSize]) {
@@ -119,7 +123,7 @@ inline void encodePacket(const PoseRecord& r, uint8_t out[kPacketSize]) {
   for (int i = 0; i < 4; ++i) putF64(out + offset::kOrientation + 8 * i, r.orientation[i]);
   out[offset::kTracking] = static_cast<uint8_t>(r.tracking);
   out[offset::kFlags] = r.flags;
-  putU16(out + offset::kReserved, 0);
+  putU16(out + offset::kWorldRevision, r.world_revision);
   putF32(out + offset::kQuality, r.quality);
 }
 
@@ -140,6 +144,7 @@ inline DecodeStatus decodePacket(const uint8_t* data, std::size_t size, PoseReco
   for (int i = 0; i < 4; ++i) r.orientation[i] = getF64(data + offset::kOrientation + 8 * i);
   r.tracking = static_cast<Tracking>(data[offset::kTracking]);
   r.flags = data[offset::kFlags];
+  r.world_revision = getU16(data + offset::kWorldRevision);
   r.quality = getF32(data + offset::kQuality);
   return DecodeStatus::Ok;
 }

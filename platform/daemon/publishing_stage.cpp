@@ -73,6 +73,7 @@ void PublishingStage::publish(const PoseSlot& slot) {
   r.flags = static_cast<uint8_t>((e.valid ? pose::kFlagValid : 0) | (e.is_keyframe ? pose::kFlagKeyframe : 0) |
                                  (e.metric ? 0 : pose::kFlagUnscaled));
   r.quality = e.quality;
+  r.world_revision = e.world_revision;
   if (shm_) shm_->publish(r);
   udp_.send(r);
   if (slot.trigger_mono_ns > 0) latency_.record(monotonicNowNs() - slot.trigger_mono_ns);

@@ -295,8 +295,8 @@ void Odometry::relocalize(const FrameFeatures& frame, uint64_t frame_index, cons
   settled_count_ = 0;  // the caller took the last frame's before it asked
   resetMap();
   anchor_ = T_w_b;
-  const int kf = mapper_->insertSeededKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, seeds, T_w_b,
-                                               frame_index);
+  const int kf =
+      mapper_->insertSeededKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, seeds, T_w_b, frame_index);
   if (kf < 0) return;
   bridge_->optimize(map_, kf);
   ++stats_.relocalizations;

@@ -38,8 +38,8 @@ SlamPipeline::SlamPipeline(const Rig& rig, const PipelineConfig& config)
   handover_ = effectiveOdometryOptions(config_, front_end_.overlap()).refine_extrinsics && rig_.size() > 1;
   if (config_.places.enabled) {
     vocabulary_ = std::make_unique<Vocabulary>(loadVocabulary(config_.places.vocabulary));
-    places_ = std::make_unique<PlaceMemory>(rig_, *vocabulary_, config_.places, config_.odometry,
-                                            config_.orb.max_features);
+    places_ =
+        std::make_unique<PlaceMemory>(rig_, *vocabulary_, config_.places, config_.odometry, config_.orb.max_features);
   }
   if (handover_) rig_after_.assign(2, RigState(rig_));
 }
@@ -99,6 +99,14 @@ void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {
 
 void SlamPipeline::keyframes(std::vector<KeyframePose>& out) const {
   out.clear();
+  if (places_) {  // the whole map, in the world frame, as loop closures left it
+    const PlaceMap& map = places_->map();
+    for (int i = 0; i < map.capacity(); ++i) {
+      const PlaceKeyframe& kf = map.keyframe(i);
+      if (kf.alive) out.push_back(KeyframePose{kf.id, kf.t, kf.T_w_k});
+    }
+    return;
+  }
   const Map& map = odometry_.map();
   for (int i = 0; i < map.keyframeCapacity(); ++i) {
     const Keyframe& kf = map.keyframe(i);

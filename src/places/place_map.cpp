@@ -61,8 +61,8 @@ void PlaceMap::finishKeyframe(int slot) {
 
 std::span<const PlacePoint> PlaceMap::pointsOfNode(int slot, int32_t node) const {
   const std::span<const PlacePoint> all = points(slot);
-  const auto lo = std::lower_bound(all.begin(), all.end(), node,
-                                   [](const PlacePoint& p, int32_t n) { return p.node < n; });
+  const auto lo =
+      std::lower_bound(all.begin(), all.end(), node, [](const PlacePoint& p, int32_t n) { return p.node < n; });
   auto hi = lo;
   while (hi != all.end() && hi->node == node) ++hi;
   return {all.data() + (lo - all.begin()), static_cast<std::size_t>(hi - lo)};

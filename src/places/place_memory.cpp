@@ -12,6 +12,7 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       database_(vocabulary.wordCount(), options.max_keyframes, options.max_words_per_keyframe),
       words_(rig.size(), max_features_per_camera),
       relocalizer_(rig, options, odometry_options.scale_factor, max_features_per_camera),
+      loop_closer_(rig, options, odometry_options.scale_factor, max_features_per_camera),
       seeds_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
       landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1) {}
 
@@ -22,6 +23,7 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   if (out.state != TrackingState::Tracking && map_.size() > 0 && segment_ >= 0)
     relocalize(frame, frame_index, odometry, out);
   if (out.valid && segment_ >= 0) out.T_w_b = map_.segmentPose(segment_) * out.T_w_b;
+  out.world_revision = world_revision_;
 }
 
 // A new odometry map (after a loss nothing bridged, or the very first) is a new segment. Its frame continues the
@@ -59,6 +61,9 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
       if (lm < 0 || !local.landmark(lm).alive || landmark_stamp_[static_cast<std::size_t>(lm)] == kf.id) continue;
       landmark_stamp_[static_cast<std::size_t>(lm)] = kf.id;
       const Landmark& l = local.landmark(lm);
+      // Only points whose position is certain anchor a place: a multi-view point (depth to about 1%), or one the
+      // back-end has seen from three keyframes; a young point triangulated across two keyframes may be off by 15%.
+      if (!l.metric && local.observingKeyframes(lm) < 3) continue;
       PlacePoint p;
       p.p_k = (T_k_o * l.p_w).cast<float>();
       p.descriptor = l.descriptor;
@@ -73,10 +78,13 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   words_.compute(vocabulary_, kf.features);
   database_.insert(slot, words_.bow());
   ++stats_.keyframes;
+  if (options_.loop_closure) {
+    loop_closer_.setRig(odometry.trackingRig());
+    if (loop_closer_.onKeyframe(slot, kf.features, words_, map_, database_)) ++world_revision_;
+  }
 }
 
-void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry,
-                             PoseEstimate& out) {
+void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out) {
   ++stats_.relocalization_queries;
   words_.compute(vocabulary_, frame);
   relocalizer_.setRig(odometry.trackingRig());

@@ -24,8 +24,7 @@ AbsolutePoseRansacOptions ransacOptions() {
 
 }  // namespace
 
-Relocalizer::Relocalizer(const Rig& rig, const PlacesOptions& options, float scale_factor,
-                         int max_features_per_camera)
+Relocalizer::Relocalizer(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera)
     : rig_(rig),
       options_(options),
       candidates_(static_cast<std::size_t>(options.max_candidates)),
@@ -47,7 +46,8 @@ Relocalizer::Relocalizer(const Rig& rig, const PlacesOptions& options, float sca
 
 void Relocalizer::prepareFrame(const FrameFeatures& frame) {
   for (int c = 0; c < frame.cameras(); ++c)
-    if (frame.present[static_cast<std::size_t>(c)]) grids_[static_cast<std::size_t>(c)].build(frame.sets[static_cast<std::size_t>(c)]);
+    if (frame.present[static_cast<std::size_t>(c)])
+      grids_[static_cast<std::size_t>(c)].build(frame.sets[static_cast<std::size_t>(c)]);
 }
 
 int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& map, const SE3& T_w_b) {
@@ -70,7 +70,8 @@ int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& 
         const Vec3 p_c = T_c_k * p.p_k.cast<double>();
         Vec2 uv;
         if (p_c.z() <= 0 || !model.project(p_c, uv) || !model.inImage(uv, 0)) continue;
-        const double radius = kSearchRadiusPx * octave_sigma_[static_cast<std::size_t>(std::clamp<int>(p.octave, 0, 31))];
+        const double radius =
+            kSearchRadiusPx * octave_sigma_[static_cast<std::size_t>(std::clamp<int>(p.octave, 0, 31))];
         grids_[static_cast<std::size_t>(c)].forEachNear(uv.x(), uv.y(), radius, [&](const KeypointGrid::Entry& e) {
           if ((Vec2(e.x, e.y) - uv).squaredNorm() > radius * radius) return;
           const int d = hammingDistance(p.descriptor, set.descriptors[static_cast<std::size_t>(e.index)]);
@@ -104,9 +105,9 @@ void Relocalizer::addMatch(const FrameFeatures& frame, const PlaceMap& map, int 
   const Keypoint& kp = frame.sets[static_cast<std::size_t>(c)].keypoints[static_cast<std::size_t>(k)];
   const Vec3 p_w = map.keyframe(keyframe).T_w_k * point->p_k.cast<double>();
   matches_[static_cast<std::size_t>(count)] = {static_cast<int16_t>(c), k, p_w, point};
-  observations_[static_cast<std::size_t>(count)] =
-      makePoseObservation(rig_, c, Vec2(kp.x, kp.y), frame.bearings[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)],
-                          p_w, octave_sigma_[static_cast<std::size_t>(std::clamp<int>(kp.octave, 0, 31))]);
+  observations_[static_cast<std::size_t>(count)] = makePoseObservation(
+      rig_, c, Vec2(kp.x, kp.y), frame.bearings[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)], p_w,
+      octave_sigma_[static_cast<std::size_t>(std::clamp<int>(kp.octave, 0, 31))]);
   ++count;
 }
 
@@ -180,8 +181,8 @@ bool Relocalizer::verify(const FrameFeatures& frame, const FrameWords& words, co
   if (!r.ok()) return false;
   // The consensus may be repeated texture: the pose must find its points where they project.
   const int projected = searchByProjection(frame, map, r.T_w_b);
-  const PoseRefinementResult refined =
-      refiner_.refine(std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(projected)), r.T_w_b);
+  const PoseRefinementResult refined = refiner_.refine(
+      std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(projected)), r.T_w_b);
   spdlog::debug("relocalizer: keyframe {} (group {}): {} matches, {} RANSAC inliers, {} by projection, {} inliers",
                 map.keyframe(keyframe).id, group_count_, matched, r.num_inliers, projected, refined.num_inliers);
   // A right pose explains most of what it projects onto similar keypoints, and a good part of the frame; a pose

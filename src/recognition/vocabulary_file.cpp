@@ -117,7 +117,8 @@ std::vector<std::string> defaultVocabularyCandidates() {
   std::vector<std::string> out;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) out.push_back((exe.parent_path() / "../share/mcslam/places" / MCSLAM_VOCABULARY_FILE_NAME).lexically_normal());
+  if (!ec)
+    out.push_back((exe.parent_path() / "../share/mcslam/places" / MCSLAM_VOCABULARY_FILE_NAME).lexically_normal());
   for (const char* fixed : {MCSLAM_VOCABULARY_SOURCE_PATH, MCSLAM_VOCABULARY_INSTALL_PATH})
     if (std::find(out.begin(), out.end(), fixed) == out.end()) out.push_back(fixed);
   return out;

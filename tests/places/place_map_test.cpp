@@ -33,7 +33,7 @@ TEST(PlaceMap, KeyframesChainWithinTheirSegment) {
   EXPECT_EQ(map.keyframe(a).next, -1);
   EXPECT_EQ(map.newestKeyframe(), a);
   const int d = map.createKeyframe(s0, 4, 4, SE3(), SE3());
-  EXPECT_EQ(d, c);  // the slot is recycled ...
+  EXPECT_EQ(d, c);                                    // the slot is recycled ...
   EXPECT_GT(map.keyframe(d).id, map.keyframe(b).id);  // ... the id is not
   EXPECT_EQ(map.keyframe(a).next, d);
   EXPECT_EQ(map.size(), 3);

@@ -26,10 +26,10 @@ class Relocalization : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = std::make_unique<test::TempDir>("relocalization");
     std::string out;
-    const int code = test::runCommand(test::binPath("mcslam-sim") + " --rig isec --cameras 0,1,2,3,4 --world indoor " +
-                                          "--frames " + std::to_string(kFrames) + " --no-depth --quiet --out " +
-                                          dir_->file("seq"),
-                                      &out);
+    const int code =
+        test::runCommand(test::binPath("mcslam-sim") + " --rig isec --cameras 0,1,2,3,4 --world indoor " + "--frames " +
+                             std::to_string(kFrames) + " --no-depth --quiet --out " + dir_->file("seq"),
+                         &out);
     ASSERT_EQ(code, 0) << out;
   }
   static void TearDownTestSuite() { dir_.reset(); }
@@ -44,8 +44,8 @@ class Relocalization : public ::testing::Test {
     Run r;
     std::string out;
     const std::string traj = dir_->file(tag + ".tum"), stats = dir_->file(tag + ".json");
-    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") +
-                                   " --quiet --out " + traj + " --stats " + stats + " " + faults,
+    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --out " +
+                                   traj + " --stats " + stats + " " + faults,
                                &out),
               0)
         << out;

@@ -22,6 +22,7 @@ TEST(PoseProtocol, BytesSitAtTheDocumentedOffsetsLittleEndian) {
   r.tracking = Tracking::Lost;
   r.flags = kFlagValid | kFlagKeyframe | kFlagUnscaled;
   r.quality = 0.5f;
+  r.world_revision = 0x0203;
   uint8_t b[kPacketSize];
   encodePacket(r, b);
   const uint8_t magic[4] = {'M', 'C', 'S', 'P'};
@@ -42,8 +43,8 @@ TEST(PoseProtocol, BytesSitAtTheDocumentedOffsetsLittleEndian) {
   EXPECT_EQ(b[88 + 7], 0x3F);  // qw = 1.0
   EXPECT_EQ(b[96], 2);
   EXPECT_EQ(b[97], 7);
-  EXPECT_EQ(b[98], 0);
-  EXPECT_EQ(b[99], 0);
+  EXPECT_EQ(b[98], 3);  // world_revision
+  EXPECT_EQ(b[99], 2);
   // 0.5f = 0x3F000000
   EXPECT_EQ(b[100], 0);
   EXPECT_EQ(b[103], 0x3F);
@@ -65,6 +66,7 @@ TEST(PoseProtocol, RoundTripsEveryField) {
   r.tracking = Tracking::Tracking;
   r.flags = kFlagValid;
   r.quality = 0.75f;
+  r.world_revision = 65535;
   uint8_t b[kPacketSize];
   encodePacket(r, b);
   PoseRecord d;
@@ -79,6 +81,7 @@ TEST(PoseProtocol, RoundTripsEveryField) {
   EXPECT_TRUE(d.valid());
   EXPECT_FALSE(d.keyframe());
   EXPECT_EQ(d.quality, 0.75f);
+  EXPECT_EQ(d.world_revision, 65535);
 }
 
 TEST(PoseProtocol, RejectsShortForeignAndFutureDatagrams) {

@@ -29,6 +29,7 @@ struct RunOptions {
   std::string log_level = "info";
   std::size_t max_frames = 0;
   std::string black_text, skip_text;  // fault injection: frame ranges "A-B"
+  bool no_loop_closure = false;
 };
 
 // A range of frames "A-B" (both included) or "A"; empty text: none. Throws InputError naming the option.
@@ -70,6 +71,8 @@ void addOptions(CLI::App& app, RunOptions& o) {
   app.add_option("--extrinsics", o.extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", o.max_frames, "Process only the first N rig frames (0: all)");
   app.add_flag("--quiet", o.quiet, "No progress bar");
+  app.add_flag("--no-loop-closure", o.no_loop_closure,
+               "Relocalize, but close no loop (places.loop_closure: false), for comparisons");
   app.add_option("--black", o.black_text,
                  "Fault injection: every camera's image of frames A-B (dataset indices) is black, as if the rig were "
                  "covered");
@@ -260,8 +263,9 @@ int runDataset(const RunOptions& o) {
   const Dataset ds = Dataset::open(o.dataset_dir, dopt);
   for (const std::string& w : ds.warnings()) std::fprintf(stderr, "mcslam-run: warning: %s\n", w.c_str());
   if (ds.size() == 0) throw InputError(o.dataset_dir + ": the dataset has no frames");
-  const PipelineConfig config =
+  PipelineConfig config =
       parsePipelineConfig(slamSection(o.config_path), o.config_path.empty() ? "defaults" : o.config_path, ds.rig());
+  if (o.no_loop_closure) config.places.loop_closure = false;
   if (o.print_config) {
     std::fputs(formatPipelineConfig(config).c_str(), stdout);
     return 0;

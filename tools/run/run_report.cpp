@@ -144,6 +144,12 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("relocalizations").value(p.relocalizations);
     j.key("segments").value(p.segments);
     j.key("last_relocalized_frame").value(static_cast<long long>(p.last_relocalized_frame));
+    const LoopStats& l = places->loopStats();
+    j.key("loop_queries").value(l.queries);
+    j.key("loops_verified").value(l.verified);
+    j.key("loop_closures").value(l.closures);
+    j.key("map_merges").value(l.merges);
+    j.key("world_revision").value(static_cast<unsigned long long>(places->worldRevision()));
     j.endObject();
   }
   j.key("timing_ms").beginObject();

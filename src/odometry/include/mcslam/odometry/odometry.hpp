@@ -25,7 +25,7 @@ struct OdometryStats {
   uint64_t lost = 0;
   uint64_t initializations = 0;
   uint64_t keyframes = 0;
-  uint64_t recoveries = 0;  // frames tracked only through the descriptor fallback
+  uint64_t recoveries = 0;       // frames tracked only through the descriptor fallback
   uint64_t relocalizations = 0;  // lost frames the place map found (relocalize())
   uint64_t backend_solves = 0;
   uint64_t extrinsic_reestimations = 0;  // cameras whose extrinsic the per-camera check replaced

@@ -34,6 +34,9 @@ struct PoseEstimate {
   // T_w_b.t is in metres. False when its unit is arbitrary: one camera, or a rig without overlap whose map
   // started up to scale and has not yet found it.
   bool metric = true;
+  // Times the world estimate has moved so far (loop closures, map merges): a consumer that sees it change knows
+  // that the jump between this pose and the one before is a correction of the world, not motion.
+  uint16_t world_revision = 0;
 };
 
 }  // namespace mcslam

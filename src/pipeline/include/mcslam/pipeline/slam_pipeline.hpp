@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "mcslam/odometry/odometry.hpp"
-#include "mcslam/places/place_memory.hpp"
 #include "mcslam/pipeline/front_end.hpp"
+#include "mcslam/places/place_memory.hpp"
 
 namespace mcslam {
 
@@ -47,7 +47,8 @@ class SlamPipeline final : public FrameProcessor {
   bool initialized() const { return odometry_.initialized(); }
   // The frame the map was last initialized from (its sequence number), -1 before the first initialization.
   int64_t initializationReference() const { return odometry_.lastInitializationReference(); }
-  // The keyframes in the map now (appended to `out`, which is cleared first).
+  // The keyframes in the map now (appended to `out`, which is cleared first): with place memory every keyframe of
+  // the place map in the world frame (loop-corrected), else the odometry's local map.
   void keyframes(std::vector<KeyframePose>& out) const;
   Rig refinedRig() const { return odometry_.refinedRig(); }
   // The back-end's current extrinsics (the calibration's when refinement is off).

@@ -34,8 +34,8 @@ struct PlaceKeyframe {
   int32_t segment = -1;
   Timestamp t = 0;
   uint64_t frame_index = 0;
-  SE3 T_w_k;  // world pose (moved by loop closures)
-  SE3 T_o_k;  // pose in its segment's odometry frame when it was made
+  SE3 T_w_k;                         // world pose (moved by loop closures)
+  SE3 T_o_k;                         // pose in its segment's odometry frame when it was made
   int32_t previous = -1, next = -1;  // neighbours in its segment (slots)
   int32_t point_count = 0;
 };

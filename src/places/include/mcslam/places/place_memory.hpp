@@ -9,6 +9,7 @@
 
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/odometry/odometry.hpp"
+#include "mcslam/places/loop_closer.hpp"
 #include "mcslam/places/place_map.hpp"
 #include "mcslam/places/places_options.hpp"
 #include "mcslam/places/relocalizer.hpp"
@@ -19,11 +20,11 @@
 namespace mcslam {
 
 struct PlaceStats {
-  uint64_t keyframes = 0;               // added to the place map
-  uint64_t keyframes_dropped = 0;       // not added: the map was full
-  uint64_t relocalization_queries = 0;  // lost frames that queried the database
-  uint64_t relocalizations = 0;         // ... and were found
-  uint64_t segments = 0;                // odometry maps started (the first one included)
+  uint64_t keyframes = 0;                  // added to the place map
+  uint64_t keyframes_dropped = 0;          // not added: the map was full
+  uint64_t relocalization_queries = 0;     // lost frames that queried the database
+  uint64_t relocalizations = 0;            // ... and were found
+  uint64_t segments = 0;                   // odometry maps started (the first one included)
   int64_t last_relocalized_keyframe = -1;  // id of the place keyframe the last relocalization verified on
   int64_t last_relocalized_frame = -1;     // frame index of the last relocalization
 };
@@ -41,6 +42,9 @@ class PlaceMemory {
   const PlaceStats& stats() const { return stats_; }
   // The segment the odometry's current map belongs to (-1 before the first map).
   int32_t segment() const { return segment_; }
+  const LoopStats& loopStats() const { return loop_closer_.stats(); }
+  // Times the world estimate moved (loop closures, merges); PoseEstimate::world_revision carries it.
+  uint16_t worldRevision() const { return world_revision_; }
 
  private:
   void followSegment(const Odometry& odometry);
@@ -53,10 +57,12 @@ class PlaceMemory {
   PlaceDatabase database_;
   FrameWords words_;
   Relocalizer relocalizer_;
+  LoopCloser loop_closer_;
   std::vector<MapSeed> seeds_;
   std::vector<int64_t> landmark_stamp_;  // per odometry landmark slot: the keyframe id it was last added for
   int32_t segment_ = -1;
   uint64_t initializations_seen_ = 0;
+  uint16_t world_revision_ = 0;
   PlaceStats stats_;
 };
 

@@ -10,9 +10,9 @@ struct PlacesOptions {
   std::string vocabulary;  // empty: the shipped vocabulary (defaultVocabularyCandidates())
 
   // Capacities.
-  int max_keyframes = 1500;            // place keyframes of the whole map
-  int max_points_per_keyframe = 600;   // points anchored in one keyframe (its landmarks)
-  int max_words_per_keyframe = 2000;   // words one keyframe keeps in the database (its heaviest)
+  int max_keyframes = 1500;           // place keyframes of the whole map
+  int max_points_per_keyframe = 600;  // points anchored in one keyframe (its landmarks)
+  int max_words_per_keyframe = 2000;  // words one keyframe keeps in the database (its heaviest)
 
   // Recognition: the database's candidates are those above this share of the best score, at most this many.
   float candidate_share = 0.75f;
@@ -20,12 +20,17 @@ struct PlacesOptions {
   int min_words_shared = 20;  // fewer shared words: no candidate
 
   // Verification (generalized P3P in RANSAC on the matched points, then refinement).
-  int max_hamming = 64;        // of 256 bits, for a keypoint-to-point match
-  float match_ratio = 0.8f;    // best / second best
-  int min_inliers = 50;        // a relocalization needs this many inliers at the refined pose (after the guided search)
+  int max_hamming = 64;      // of 256 bits, for a keypoint-to-point match
+  float match_ratio = 0.8f;  // best / second best
+  int min_inliers = 50;      // a relocalization needs this many inliers at the refined pose (after the guided search)
   float min_inlier_share = 0.4f;  // ... and this share of the matches the guided search found
   float min_frame_share = 0.05f;  // ... and this share of the frame's keypoints
-  int neighbour_keyframes = 2;  // each side of the candidate in its segment: their points join the candidate's
+  int neighbour_keyframes = 2;    // each side of the candidate in its segment: their points join the candidate's
+
+  // Loop closure.
+  bool loop_closure = true;
+  int loop_min_keyframes_apart = 30;  // an older keyframe of the same segment is a loop candidate only this far back
+  int max_loops = 500;                // loop edges kept in the pose graph
 
   // Relocalization: how long the odometry stays lost, trying to relocalize, before it starts a new map.
   double relocalization_timeout_s = 3.0;

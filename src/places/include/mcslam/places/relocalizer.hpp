@@ -57,8 +57,8 @@ class Relocalizer {
       ++result.candidates;
       if (verify(frame, words, map, prior, result)) return result;
     }
-    const int n = database.query(words.bow(), 0.0f, candidates_,
-                                 [&](int slot) { return slot != prior && !exclude(slot); });
+    const int n =
+        database.query(words.bow(), 0.0f, candidates_, [&](int slot) { return slot != prior && !exclude(slot); });
     if (n == 0) return result;
     const float bar = options_.candidate_share * candidates_[0].score;
     for (int i = 0; i < n && candidates_[static_cast<std::size_t>(i)].score >= bar; ++i) {

@@ -1,0 +1,64 @@
+#pragma once
+// Loop closure over the place map: each new place keyframe looks for an older place it sees again (the database,
+// then the relocalizer's verification: generalized P3P, guided search, strict acceptance), among keyframes the
+// odometry can no longer reach (of another segment, or `loop_min_keyframes_apart` keyframes older). A loop is
+// accepted when two consecutive keyframes of the segment find it with the same correction (zero false closures
+// is the rule). It then becomes an edge of the pose graph over every place keyframe (consecutive keyframes joined
+// by the odometry's relative poses), which is solved; the keyframes (and the points anchored in them) take the
+// solution, and every segment's T_w_o follows its newest keyframe. Fixed memory.
+#include <cstdint>
+#include <vector>
+
+#include "mcslam/backend/pose_graph.hpp"
+#include "mcslam/places/place_map.hpp"
+#include "mcslam/places/places_options.hpp"
+#include "mcslam/places/relocalizer.hpp"
+
+namespace mcslam {
+
+struct LoopStats {
+  uint64_t queries = 0;
+  uint64_t verified = 0;   // candidates that passed verification (before the consistency check)
+  uint64_t closures = 0;   // accepted: the map was corrected
+  uint64_t merges = 0;     // closures that joined two segments
+  int64_t last_keyframe = -1, last_candidate = -1;  // place keyframe ids of the last closure
+  double last_correction_m = 0, last_correction_deg = 0;
+  double last_solve_ms = 0;
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera);
+
+  void setRig(const Rig& rig) { verifier_.setRig(rig); }
+  // Keyframe `slot` (just added, with the frame it was made of and its words): true when a loop was closed and the
+  // map's poses and segments' frames moved.
+  bool onKeyframe(int slot, const FrameFeatures& features, const FrameWords& words, PlaceMap& map,
+                  const PlaceDatabase& database);
+  const LoopStats& stats() const { return stats_; }
+  void clear();
+
+ private:
+  struct LoopEdge {
+    int64_t a = -1, b = -1;  // place keyframe ids
+    SE3 T_a_b;
+  };
+  bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
+  void correct(PlaceMap& map);
+
+  PlacesOptions options_;
+  Relocalizer verifier_;
+  backend::PoseGraph graph_;
+  std::vector<LoopEdge> loops_;
+  int loop_count_ = 0;
+  std::vector<int32_t> node_of_slot_, slot_of_node_;
+  std::vector<int32_t> segment_root_;  // union-find over segments joined by loops
+  // The last verified detection, waiting for the next keyframe to confirm it.
+  int64_t pending_keyframe_ = -1;
+  int32_t pending_segment_ = -1;
+  int64_t pending_candidate_ = -1;
+  SE3 pending_correction_;
+  LoopStats stats_;
+};
+
+}  // namespace mcslam

@@ -1,0 +1,170 @@
+#include "mcslam/places/loop_closer.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+namespace mcslam {
+
+namespace {
+
+// The odometry's relative pose between consecutive keyframes: about 1% of the distance and of the angle, plus a
+// floor (a keyframe pair that hardly moved is still only known to a few millimetres and a tenth of a degree).
+Vec6 odometrySigma(const SE3& T_a_b) {
+  const double d = T_a_b.t.norm();
+  const double angle = so3Log(T_a_b.R).norm();
+  Vec6 s;
+  s.head<3>().setConstant(0.005 + 0.01 * d);
+  s.tail<3>().setConstant(0.002 + 0.01 * angle + 0.001 * d);
+  return s;
+}
+
+// A verified loop: the relative pose by generalized P3P over hundreds of points.
+Vec6 loopSigma() {
+  Vec6 s;
+  s.head<3>().setConstant(0.01);
+  s.tail<3>().setConstant(0.002);
+  return s;
+}
+
+int32_t findRoot(std::vector<int32_t>& root, int32_t s) {
+  while (root[static_cast<std::size_t>(s)] != s) s = root[static_cast<std::size_t>(s)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(s)])];
+  return s;
+}
+
+}  // namespace
+
+LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera)
+    : options_(options),
+      verifier_(rig, options, scale_factor, max_features_per_camera),
+      graph_(options.max_keyframes, 2 * options.max_keyframes + options.max_loops),
+      loops_(static_cast<std::size_t>(options.max_loops)),
+      node_of_slot_(static_cast<std::size_t>(options.max_keyframes), -1),
+      slot_of_node_(static_cast<std::size_t>(options.max_keyframes), -1),
+      segment_root_(PlaceMap::kMaxSegments) {
+  clear();
+}
+
+void LoopCloser::clear() {
+  loop_count_ = 0;
+  for (int32_t s = 0; s < PlaceMap::kMaxSegments; ++s) segment_root_[static_cast<std::size_t>(s)] = s;
+  pending_keyframe_ = -1;
+}
+
+bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const FrameWords& words, PlaceMap& map,
+                            const PlaceDatabase& database) {
+  const PlaceKeyframe& k = map.keyframe(slot);
+  const auto reachable = [&](int other) {
+    const PlaceKeyframe& o = map.keyframe(other);
+    return other == slot ||
+           (o.segment == k.segment && k.id - o.id < options_.loop_min_keyframes_apart);
+  };
+  ++stats_.queries;
+  const RelocalizationResult r = verifier_.locate(features, words, map, database, -1, reachable);
+  if (!r.ok) {
+    pending_keyframe_ = -1;
+    return false;
+  }
+  ++stats_.verified;
+  const SE3 correction = r.T_w_b * k.T_w_k.inverse();  // moves the drifted keyframe onto the recognized place
+  const int64_t candidate = map.keyframe(r.keyframe).id;
+  const bool confirmed = consistentWithLast(slot, map, correction);
+  pending_keyframe_ = k.id;
+  pending_segment_ = k.segment;
+  pending_candidate_ = candidate;
+  pending_correction_ = correction;
+  if (!confirmed) return false;
+  if (loop_count_ == static_cast<int>(loops_.size())) {
+    spdlog::warn("place memory: {} loop closures kept; no room for another (places.max_loops)", loops_.size());
+    return false;
+  }
+  loops_[static_cast<std::size_t>(loop_count_++)] = {candidate, k.id, map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b};
+  const int32_t root_k = findRoot(segment_root_, k.segment);
+  const int32_t root_c = findRoot(segment_root_, map.keyframe(r.keyframe).segment);
+  if (root_k != root_c) {
+    segment_root_[static_cast<std::size_t>(std::max(root_k, root_c))] = std::min(root_k, root_c);
+    ++stats_.merges;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  correct(map);
+  stats_.last_solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  ++stats_.closures;
+  stats_.last_keyframe = k.id;
+  stats_.last_candidate = candidate;
+  stats_.last_correction_m = correction.t.norm();
+  stats_.last_correction_deg = so3Log(correction.R).norm() * 180.0 / M_PI;
+  spdlog::info("place memory: loop closed: keyframe {} (t = {:.3f} s) sees keyframe {} (t = {:.3f} s) again ({} inliers); "
+               "correction {:.3f} m, {:.2f} deg; pose graph solved in {:.1f} ms",
+               k.id, toSeconds(k.t), candidate, toSeconds(map.keyframe(r.keyframe).t), r.inliers,
+               stats_.last_correction_m, stats_.last_correction_deg, stats_.last_solve_ms);
+  pending_keyframe_ = -1;
+  return true;
+}
+
+// The detection of the keyframe before this one (same segment) found a correction that agrees with this one.
+bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const {
+  const PlaceKeyframe& k = map.keyframe(slot);
+  if (pending_keyframe_ < 0 || pending_segment_ != k.segment || k.previous < 0 ||
+      map.keyframe(k.previous).id != pending_keyframe_)
+    return false;
+  const SE3 difference = pending_correction_.inverse() * correction;
+  const double distance = std::max(1.0, (k.T_w_k.t - map.keyframe(k.previous).T_w_k.t).norm() + correction.t.norm());
+  return difference.t.norm() < 0.05 * distance && so3Log(difference.R).norm() < 2.0 * M_PI / 180.0;
+}
+
+void LoopCloser::correct(PlaceMap& map) {
+  graph_.clear();
+  std::fill(node_of_slot_.begin(), node_of_slot_.end(), -1);
+  // Nodes in slot order; each connected set of segments is held by the first keyframe of its lowest segment.
+  for (int slot = 0; slot < map.capacity(); ++slot) {
+    const PlaceKeyframe& k = map.keyframe(slot);
+    if (!k.alive) continue;
+    const int node = graph_.addNode(k.T_w_k, false);
+    node_of_slot_[static_cast<std::size_t>(slot)] = node;
+    slot_of_node_[static_cast<std::size_t>(node)] = slot;
+  }
+  for (int32_t s = 0; s < map.segments(); ++s) {
+    // The oldest keyframe of the segment whose root it is holds the gauge of the joined set.
+    if (findRoot(segment_root_, s) != s) continue;
+    int oldest = -1;
+    for (int slot = 0; slot < map.capacity(); ++slot) {
+      const PlaceKeyframe& k = map.keyframe(slot);
+      if (k.alive && k.segment == s && k.previous < 0) oldest = slot;
+    }
+    if (oldest >= 0) graph_.setFixed(node_of_slot_[static_cast<std::size_t>(oldest)], true);
+  }
+  for (int slot = 0; slot < map.capacity(); ++slot) {
+    const PlaceKeyframe& k = map.keyframe(slot);
+    if (!k.alive || k.previous < 0) continue;
+    const SE3 T_a_b = map.keyframe(k.previous).T_o_k.inverse() * k.T_o_k;
+    graph_.addEdge(node_of_slot_[static_cast<std::size_t>(k.previous)], node_of_slot_[static_cast<std::size_t>(slot)],
+                   T_a_b, odometrySigma(T_a_b));
+  }
+  for (int i = 0; i < loop_count_; ++i) {
+    const LoopEdge& e = loops_[static_cast<std::size_t>(i)];
+    int a = -1, b = -1;
+    for (int slot = 0; slot < map.capacity() && (a < 0 || b < 0); ++slot) {
+      const PlaceKeyframe& k = map.keyframe(slot);
+      if (!k.alive) continue;
+      if (k.id == e.a) a = slot;
+      if (k.id == e.b) b = slot;
+    }
+    if (a >= 0 && b >= 0)
+      graph_.addEdge(node_of_slot_[static_cast<std::size_t>(a)], node_of_slot_[static_cast<std::size_t>(b)], e.T_a_b,
+                     loopSigma());
+  }
+  graph_.optimize();
+  for (int node = 0; node < graph_.nodes(); ++node)
+    map.setKeyframePose(slot_of_node_[static_cast<std::size_t>(node)], graph_.pose(node));
+  // Each segment's odometry frame follows its newest keyframe: the odometry goes on from where the map now puts it.
+  for (int32_t s = 0; s < map.segments(); ++s) {
+    int newest = -1;
+    for (int slot = 0; slot < map.capacity(); ++slot) {
+      const PlaceKeyframe& k = map.keyframe(slot);
+      if (k.alive && k.segment == s && k.next < 0) newest = slot;
+    }
+    if (newest >= 0) map.setSegmentPose(s, map.keyframe(newest).T_w_k * map.keyframe(newest).T_o_k.inverse());
+  }
+}
+
+}  // namespace mcslam

@@ -1,0 +1,126 @@
+// Loop closure end to end: a 3-camera rig drives 6 m down the start of the indoor route, turns round, drives back
+// and turns round again at its start (mcslam-sim renders the route from a TUM file). Back at the start it sees the
+// first place again: the loop closes, every closure joins keyframes that are truly near each other (no false
+// closure), the world revision counts the corrections, and the corrected keyframe trajectory ends nearer its start
+// than the run without loop closure.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <regex>
+
+#include "mcslam/dataset/trajectory.hpp"
+#include "test_support.hpp"
+
+namespace mcslam {
+namespace {
+
+long jsonInt(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\":");
+  return at == std::string::npos ? -1000 : std::stol(json.substr(at + key.size() + 3));
+}
+
+// The pose of `gt` nearest in time to t.
+const SE3& nearest(const Trajectory& gt, double t) {
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < gt.size(); ++i)
+    if (std::abs(toSeconds(gt[i].t) - t) < std::abs(toSeconds(gt[best].t) - t)) best = i;
+  return gt[best].T_w_b;
+}
+
+// Out 6 m along the route's first heading, a half turn in place, back, and a half turn at the start; 10 Hz.
+void writeOutAndBack(const Trajectory& start, const std::string& path) {
+  const SE3 T0 = start.front().T_w_b;
+  Vec3 forward = start.back().T_w_b.t - T0.t;
+  forward.z() = 0;
+  forward.normalize();
+  std::ofstream out(path);
+  double t = 1.0;
+  const auto emit = [&](const Vec3& p, double yaw) {
+    const Eigen::Quaterniond q(so3Exp(Vec3(0, 0, yaw)) * T0.R);
+    out << std::fixed << t << ' ' << p.x() << ' ' << p.y() << ' ' << p.z() << ' ' << q.x() << ' ' << q.y() << ' '
+        << q.z() << ' ' << q.w() << '\n';
+    t += 0.1;
+  };
+  const double length = 6.0, speed = 0.6, turn_rate = M_PI / 4;  // m, m/s, rad/s
+  const auto drive = [&](const Vec3& from, const Vec3& direction, double yaw) {
+    for (double s = 0; s < length; s += speed * 0.1) emit(from + s * direction, yaw);
+  };
+  const auto turn = [&](const Vec3& at, double yaw0) {
+    for (double a = 0; a < M_PI; a += turn_rate * 0.1) emit(at, yaw0 + a);
+  };
+  drive(T0.t, forward, 0);
+  turn(T0.t + length * forward, 0);
+  drive(T0.t + length * forward, -forward, M_PI);
+  turn(T0.t, M_PI);
+  for (int i = 0; i < 20; ++i) emit(T0.t, 2 * M_PI);  // stand at the start, facing as at first
+}
+
+class LoopClosure : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>("loop_closure");
+    std::string out;
+    const std::string sim = test::binPath("mcslam-sim") + " --rig isec --world indoor --no-depth --quiet ";
+    ASSERT_EQ(test::runCommand(sim + "--cameras 0 --frames 11 --out " + dir_->file("start"), &out), 0) << out;
+    writeOutAndBack(readTumTrajectory(dir_->file("start/groundtruth.txt")), dir_->file("route.txt"));
+    ASSERT_EQ(test::runCommand(sim + "--cameras 1,2,3 --trajectory file:" + dir_->file("route.txt") + " --out " +
+                                   dir_->file("seq"),
+                               &out),
+              0)
+        << out;
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+
+  struct Run {
+    Trajectory keyframes;
+    std::string stats, log;
+  };
+  static Run run(const std::string& tag, const std::string& options) {
+    Run r;
+    const std::string kf = dir_->file(tag + ".kf.tum"), stats = dir_->file(tag + ".json");
+    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --keyframes " +
+                                   kf + " --stats " + stats + " " + options,
+                               &r.log),
+              0)
+        << r.log;
+    r.keyframes = readTumTrajectory(kf);
+    r.stats = test::readFile(stats);
+    return r;
+  }
+  static std::unique_ptr<test::TempDir> dir_;
+};
+
+std::unique_ptr<test::TempDir> LoopClosure::dir_;
+
+TEST_F(LoopClosure, TheRouteClosesAtItsStartWithNoFalseClosure) {
+  const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+  const Run closed = run("closed", "");
+  const Run open = run("open", "--no-loop-closure");
+  const long closures = jsonInt(closed.stats, "loop_closures");
+  EXPECT_GE(closures, 1) << closed.log;
+  EXPECT_EQ(jsonInt(closed.stats, "world_revision"), closures);
+  EXPECT_EQ(jsonInt(open.stats, "loop_closures"), 0);
+  // Every closure joins two keyframes that are within 1 m and 30 degrees of each other in truth.
+  const std::regex line(R"(t = ([0-9.]+) s\) sees keyframe [0-9]+ \(t = ([0-9.]+) s\))");
+  int seen = 0;
+  for (auto it = std::sregex_iterator(closed.log.begin(), closed.log.end(), line); it != std::sregex_iterator(); ++it) {
+    const SE3& a = nearest(gt, std::stod((*it)[1]));
+    const SE3& b = nearest(gt, std::stod((*it)[2]));
+    EXPECT_LT((a.t - b.t).norm(), 1.0) << it->str();
+    EXPECT_LT(rotationAngle(a.R, b.R), 30 * M_PI / 180) << it->str();
+    ++seen;
+  }
+  EXPECT_EQ(seen, closures);
+  // The corrected keyframes end where they started, at least as well as without the closure.
+  const auto endError = [](const Trajectory& k) { return (k.back().T_w_b.t - k.front().T_w_b.t).norm(); };
+  std::printf("closures %ld, end error closed %.4f m, open %.4f m\n", closures, endError(closed.keyframes),
+              endError(open.keyframes));
+  EXPECT_LE(endError(closed.keyframes), endError(open.keyframes) + 1e-3);
+  EXPECT_LT(endError(closed.keyframes), 0.05);
+}
+
+}  // namespace
+}  // namespace mcslam
