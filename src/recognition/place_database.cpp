@@ -7,12 +7,17 @@ namespace mcslam {
 PlaceDatabase::PlaceDatabase(int word_count, int max_places, int max_words_per_place)
     : max_words_per_place_(max_words_per_place),
       head_(static_cast<std::size_t>(word_count), -1),
-      postings_(static_cast<std::size_t>(max_places) * static_cast<std::size_t>(max_words_per_place)),
+      // Every word's chain has at most one block that is not full.
+      blocks_(static_cast<std::size_t>(max_places) * static_cast<std::size_t>(max_words_per_place) / kBlockPostings +
+              static_cast<std::size_t>(std::min<int64_t>(word_count, int64_t{max_places} * max_words_per_place)) + 1),
+      free_blocks_(blocks_.size()),
+      words_of_(static_cast<std::size_t>(max_places) * static_cast<std::size_t>(max_words_per_place)),
       word_count_of_(static_cast<std::size_t>(max_places), -1),
-      word_of_posting_(postings_.size(), 0),
       selected_(static_cast<std::size_t>(max_words_per_place)),
       score_(static_cast<std::size_t>(max_places), 0.0f),
-      touched_(static_cast<std::size_t>(max_places), 0) {}
+      touched_(static_cast<std::size_t>(max_places), 0) {
+  clear();
+}
 
 std::span<const BowEntry> PlaceDatabase::heaviest(const BowVector& v) {
   const std::span<const BowEntry> all = v.entries();
@@ -34,18 +39,44 @@ std::span<const BowEntry> PlaceDatabase::heaviest(const BowVector& v) {
   return {selected_.data(), keep};
 }
 
+void PlaceDatabase::addPosting(WordId w, Posting p) {
+  int32_t& head = head_[static_cast<std::size_t>(w)];
+  if (head < 0 || blocks_[static_cast<std::size_t>(head)].count == kBlockPostings) {
+    const int32_t b = free_blocks_[static_cast<std::size_t>(--free_block_count_)];
+    blocks_[static_cast<std::size_t>(b)].next = head;
+    blocks_[static_cast<std::size_t>(b)].count = 0;
+    head = b;
+  }
+  Block& block = blocks_[static_cast<std::size_t>(head)];
+  block.postings[block.count++] = p;
+}
+
+// The place's posting takes the word's newest one (the last of its head block); an emptied head block returns to
+// the pool.
+void PlaceDatabase::removePosting(WordId w, int32_t place) {
+  int32_t& head = head_[static_cast<std::size_t>(w)];
+  Block& first = blocks_[static_cast<std::size_t>(head)];
+  for (int32_t b = head; b >= 0; b = blocks_[static_cast<std::size_t>(b)].next) {
+    Block& block = blocks_[static_cast<std::size_t>(b)];
+    for (int i = 0; i < block.count; ++i) {
+      if (block.postings[i].place != place) continue;
+      block.postings[i] = first.postings[--first.count];
+      if (first.count == 0) {
+        free_blocks_[static_cast<std::size_t>(free_block_count_++)] = head;
+        head = first.next;
+      }
+      return;
+    }
+  }
+}
+
 void PlaceDatabase::insert(int place, const BowVector& v) {
   if (contains(place)) erase(place);
   const std::span<const BowEntry> entries = heaviest(v);
-  const int32_t base = place * max_words_per_place_;
+  const std::size_t base = static_cast<std::size_t>(place) * static_cast<std::size_t>(max_words_per_place_);
   for (std::size_t i = 0; i < entries.size(); ++i) {
-    const int32_t p = base + static_cast<int32_t>(i);
-    const WordId w = entries[i].word;
-    Posting& posting = postings_[static_cast<std::size_t>(p)];
-    posting = {place, entries[i].weight, -1, head_[static_cast<std::size_t>(w)]};
-    if (posting.next >= 0) postings_[static_cast<std::size_t>(posting.next)].prev = p;
-    head_[static_cast<std::size_t>(w)] = p;
-    word_of_posting_[static_cast<std::size_t>(p)] = w;
+    addPosting(entries[i].word, {place, entries[i].weight});
+    words_of_[base + i] = entries[i].word;
   }
   word_count_of_[static_cast<std::size_t>(place)] = static_cast<int32_t>(entries.size());
   ++stored_;
@@ -54,16 +85,8 @@ void PlaceDatabase::insert(int place, const BowVector& v) {
 void PlaceDatabase::erase(int place) {
   const int32_t count = word_count_of_[static_cast<std::size_t>(place)];
   if (count < 0) return;
-  const int32_t base = place * max_words_per_place_;
-  for (int32_t p = base; p < base + count; ++p) {
-    const Posting& posting = postings_[static_cast<std::size_t>(p)];
-    if (posting.prev >= 0) {
-      postings_[static_cast<std::size_t>(posting.prev)].next = posting.next;
-    } else {
-      head_[static_cast<std::size_t>(word_of_posting_[static_cast<std::size_t>(p)])] = posting.next;
-    }
-    if (posting.next >= 0) postings_[static_cast<std::size_t>(posting.next)].prev = posting.prev;
-  }
+  const std::size_t base = static_cast<std::size_t>(place) * static_cast<std::size_t>(max_words_per_place_);
+  for (int32_t i = 0; i < count; ++i) removePosting(words_of_[base + static_cast<std::size_t>(i)], place);
   word_count_of_[static_cast<std::size_t>(place)] = -1;
   --stored_;
 }
@@ -71,19 +94,23 @@ void PlaceDatabase::erase(int place) {
 void PlaceDatabase::clear() {
   std::fill(head_.begin(), head_.end(), -1);
   std::fill(word_count_of_.begin(), word_count_of_.end(), -1);
+  free_block_count_ = static_cast<int>(blocks_.size());
+  for (int i = 0; i < free_block_count_; ++i) free_blocks_[static_cast<std::size_t>(i)] = free_block_count_ - 1 - i;
   stored_ = 0;
 }
 
 void PlaceDatabase::accumulate(const BowVector& v) const {
   touched_count_ = 0;
   for (const BowEntry& e : v.entries()) {
-    for (int32_t p = head_[static_cast<std::size_t>(e.word)]; p >= 0;) {
-      const Posting& posting = postings_[static_cast<std::size_t>(p)];
-      float& score = score_[static_cast<std::size_t>(posting.place)];
-      if (score == 0) touched_[static_cast<std::size_t>(touched_count_++)] = posting.place;
-      // A shared word adds the smaller weight; the smallest positive float keeps a touched place marked.
-      score += std::max(std::min(e.weight, posting.weight), 1e-30f);
-      p = posting.next;
+    for (int32_t b = head_[static_cast<std::size_t>(e.word)]; b >= 0; b = blocks_[static_cast<std::size_t>(b)].next) {
+      const Block& block = blocks_[static_cast<std::size_t>(b)];
+      for (int i = 0; i < block.count; ++i) {
+        const Posting& posting = block.postings[i];
+        float& score = score_[static_cast<std::size_t>(posting.place)];
+        if (score == 0) touched_[static_cast<std::size_t>(touched_count_++)] = posting.place;
+        // A shared word adds the smaller weight; the smallest positive float keeps a touched place marked.
+        score += std::max(std::min(e.weight, posting.weight), 1e-30f);
+      }
     }
   }
 }

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "mcslam/calib/rig.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/recognition/vocabulary.hpp"
 #include "mcslam/recognition/vocabulary_trainer.hpp"
@@ -23,7 +24,7 @@ struct TrainArgs {
 };
 
 struct EvaluateArgs {
-  std::string dataset, vocabulary, csv;
+  std::string dataset, vocabulary, csv, cameras;
   RevisitOptions revisit;
   bool json = false;
 };
@@ -52,7 +53,9 @@ void info(const std::string& path) {
 
 void evaluate(const EvaluateArgs& a) {
   const Vocabulary v = readVocabularyFile(a.vocabulary);
-  const RevisitResult r = evaluateRevisits(a.dataset, v, OrbOptions{}, a.revisit);
+  RevisitOptions options = a.revisit;
+  if (!a.cameras.empty()) options.cameras = parseCameraList(a.cameras);
+  const RevisitResult r = evaluateRevisits(a.dataset, v, OrbOptions{}, options);
   int revisits = 0;
   for (const RevisitQuery& q : r.queries) revisits += q.has_revisit ? 1 : 0;
   const PrPoint raw = bestAtFullPrecision(precisionRecall(r, false));
@@ -128,6 +131,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   eval_cmd->add_option("--revisit-angle", e.revisit.revisit_angle_deg, "... and this many degrees")
       ->capture_default_str();
+  eval_cmd->add_option("--cameras", e.cameras, "Cameras of the rig to use, by calibration index (default: all)");
   eval_cmd->add_option("--csv", e.csv, "Write the precision-recall curves");
   eval_cmd->add_flag("--json", e.json, "Print the summary as JSON");
 

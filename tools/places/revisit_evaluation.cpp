@@ -37,7 +37,9 @@ struct KeyframeRecord {
 
 RevisitResult evaluateRevisits(const std::string& dataset_dir, const Vocabulary& vocabulary, const OrbOptions& orb,
                                const RevisitOptions& o) {
-  const Dataset dataset = Dataset::open(dataset_dir);
+  DatasetOptions dataset_options;
+  dataset_options.cameras = o.cameras;
+  const Dataset dataset = Dataset::open(dataset_dir, dataset_options);
   if (!dataset.groundTruth()) throw InputError(dataset_dir + ": the dataset has no ground truth to tell revisits");
   const Trajectory& gt = *dataset.groundTruth();
   const int cameras = dataset.rig().size();

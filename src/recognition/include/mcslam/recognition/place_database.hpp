@@ -5,6 +5,9 @@
 // construction from the capacities: `max_places` places of at most `max_words_per_place` words each (a place with
 // more keeps its heaviest words). Inserting, erasing and querying allocate nothing.
 //
+// A word's postings are kept in blocks of kBlockPostings from one pool, chained from the word: a query reads a
+// word's postings a cache line or two at a time, where a list of single postings would miss the cache on each.
+//
 // Places are identified by a slot in [0, max_places) that the caller owns (the place map's keyframe slot).
 // Queries use scratch inside the database: one thread queries at a time, and not while another inserts or erases.
 #include <cstdint>
@@ -55,11 +58,16 @@ class PlaceDatabase {
   }
 
  private:
+  static constexpr int kBlockPostings = 15;
   struct Posting {
     int32_t place = -1;
     float weight = 0;
-    int32_t prev = -1;  // postings of the same word: a doubly linked list through the pool
+  };
+  // 128 bytes: the word's newest postings are in its head block, which alone may be partly filled.
+  struct Block {
     int32_t next = -1;
+    int32_t count = 0;
+    Posting postings[kBlockPostings];
   };
 
   // Adds the query's overlap with every place sharing a word into score_, listing the places in touched_.
@@ -69,13 +77,18 @@ class PlaceDatabase {
   // The `max_words_per_place_` heaviest entries of v, in word order, into selected_.
   std::span<const BowEntry> heaviest(const BowVector& v);
 
+  void addPosting(WordId w, Posting p);
+  void removePosting(WordId w, int32_t place);
+
   int max_words_per_place_ = 0;
   int stored_ = 0;
-  std::vector<int32_t> head_;           // per word: first posting, -1 when none
-  std::vector<Posting> postings_;       // place p owns postings [p * max_words_per_place_, +word_count_of_[p])
-  std::vector<int32_t> word_count_of_;  // per place: postings used, -1 when the slot is empty
-  std::vector<WordId> word_of_posting_;
-  std::vector<BowEntry> selected_;  // scratch of insert()
+  std::vector<int32_t> head_;           // per word: its head block, -1 when none
+  std::vector<Block> blocks_;           // the pool
+  std::vector<int32_t> free_blocks_;    // a stack of unused block indices
+  int free_block_count_ = 0;
+  std::vector<WordId> words_of_;        // place p's words: [p * max_words_per_place_, +word_count_of_[p])
+  std::vector<int32_t> word_count_of_;  // per place: words stored, -1 when the slot is empty
+  std::vector<BowEntry> selected_;      // scratch of insert()
   mutable std::vector<float> score_;
   mutable std::vector<int32_t> touched_;
   mutable int touched_count_ = 0;
