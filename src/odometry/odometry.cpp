@@ -76,6 +76,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   frame_index_ = frame_index;
   frame_t_ = frame.t;
   settled_count_ = 0;
+  rescale_count_ = 0;
   flush();                                // the previous keyframe's solve, before this frame reads the map
   tracker_->follow(bridge_->rigState());  // a frame boundary: tracking takes the rig state as it is now
   const auto start = Clock::now();
@@ -205,6 +206,8 @@ void Odometry::estimateScale() {
   // The whole live map, the window and the motion model take the new unit at once.
   bridge_->rescale(map_, r.s, r.center);
   tracker_->rescale(r.s, r.center);
+  if (rescale_count_ < static_cast<int>(rescales_.size()))
+    rescales_[static_cast<std::size_t>(rescale_count_++)] = {r.s, r.center};
   if (r.converged) bridge_->setScaleStatus(ScaleStatus::Metric);
 }
 

@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <Eigen/LU>
 #include <chrono>
+#include <cmath>
 
 namespace mcslam {
 
@@ -19,16 +21,22 @@ Vec6 odometrySigma(const SE3& T_a_b) {
   return s;
 }
 
-// A verified loop: the relative pose by generalized P3P over hundreds of points.
-Vec6 loopSigma() {
+// A verified loop: the relative pose's standard deviations from the refinement's information, which takes the
+// candidate's points as exact: not below the floors (the points' own errors; PlacesOptions). Points far away leave
+// the translation along the view loosely known, and the edge says so.
+Vec6 loopSigma(const Mat6& information, const PlacesOptions& o) {
   Vec6 s;
-  s.head<3>().setConstant(0.01);
-  s.tail<3>().setConstant(0.002);
+  const Eigen::FullPivLU<Mat6> lu(information);
+  const Vec6 variance = lu.isInvertible() ? Vec6(lu.inverse().diagonal()) : Vec6::Constant(1e6);
+  for (int k = 0; k < 6; ++k) s[k] = std::sqrt(std::max(variance[k], 0.0));
+  s.head<3>() = s.head<3>().cwiseMax(o.loop_sigma_translation);
+  s.tail<3>() = s.tail<3>().cwiseMax(o.loop_sigma_rotation_deg * M_PI / 180.0);
   return s;
 }
 
 int32_t findRoot(std::vector<int32_t>& root, int32_t s) {
-  while (root[static_cast<std::size_t>(s)] != s) s = root[static_cast<std::size_t>(s)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(s)])];
+  while (root[static_cast<std::size_t>(s)] != s)
+    s = root[static_cast<std::size_t>(s)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(s)])];
   return s;
 }
 
@@ -56,8 +64,7 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
   const PlaceKeyframe& k = map.keyframe(slot);
   const auto reachable = [&](int other) {
     const PlaceKeyframe& o = map.keyframe(other);
-    return other == slot ||
-           (o.segment == k.segment && k.id - o.id < options_.loop_min_keyframes_apart);
+    return other == slot || (o.segment == k.segment && k.id - o.id < options_.loop_min_keyframes_apart);
   };
   ++stats_.queries;
   const RelocalizationResult r = verifier_.locate(features, words, map, database, -1, reachable);
@@ -74,11 +81,20 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
   pending_candidate_ = candidate;
   pending_correction_ = correction;
   if (!confirmed) return false;
+  // A correction within the loop measurement's own uncertainty (chi-square, 6 dof, 95%) says the map is consistent
+  // already: moving the world for it would only add the measurement's noise to every published pose.
+  const Vec6 sigma = loopSigma(r.information, options_);
+  if (correction.log().cwiseQuotient(sigma).squaredNorm() < 12.59) {
+    ++stats_.consistent;
+    pending_keyframe_ = -1;
+    return false;
+  }
   if (loop_count_ == static_cast<int>(loops_.size())) {
     spdlog::warn("place memory: {} loop closures kept; no room for another (places.max_loops)", loops_.size());
     return false;
   }
-  loops_[static_cast<std::size_t>(loop_count_++)] = {candidate, k.id, map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b};
+  loops_[static_cast<std::size_t>(loop_count_++)] = {candidate, k.id,
+                                                     map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b, sigma};
   const int32_t root_k = findRoot(segment_root_, k.segment);
   const int32_t root_c = findRoot(segment_root_, map.keyframe(r.keyframe).segment);
   if (root_k != root_c) {
@@ -93,10 +109,11 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
   stats_.last_candidate = candidate;
   stats_.last_correction_m = correction.t.norm();
   stats_.last_correction_deg = so3Log(correction.R).norm() * 180.0 / M_PI;
-  spdlog::info("place memory: loop closed: keyframe {} (t = {:.3f} s) sees keyframe {} (t = {:.3f} s) again ({} inliers); "
-               "correction {:.3f} m, {:.2f} deg; pose graph solved in {:.1f} ms",
-               k.id, toSeconds(k.t), candidate, toSeconds(map.keyframe(r.keyframe).t), r.inliers,
-               stats_.last_correction_m, stats_.last_correction_deg, stats_.last_solve_ms);
+  spdlog::info(
+      "place memory: loop closed: keyframe {} (t = {:.3f} s) sees keyframe {} (t = {:.3f} s) again ({} inliers); "
+      "correction {:.3f} m, {:.2f} deg; pose graph solved in {:.1f} ms",
+      k.id, toSeconds(k.t), candidate, toSeconds(map.keyframe(r.keyframe).t), r.inliers, stats_.last_correction_m,
+      stats_.last_correction_deg, stats_.last_solve_ms);
   pending_keyframe_ = -1;
   return true;
 }
@@ -151,7 +168,7 @@ void LoopCloser::correct(PlaceMap& map) {
     }
     if (a >= 0 && b >= 0)
       graph_.addEdge(node_of_slot_[static_cast<std::size_t>(a)], node_of_slot_[static_cast<std::size_t>(b)], e.T_a_b,
-                     loopSigma());
+                     e.sigma);
   }
   graph_.optimize();
   for (int node = 0; node < graph_.nodes(); ++node)

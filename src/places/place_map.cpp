@@ -81,6 +81,18 @@ void PlaceMap::eraseKeyframe(int slot) {
   --live_;
 }
 
+void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {
+  const SE3& T_w_o = segment_T_w_o_[static_cast<std::size_t>(segment)];
+  for (int slot = 0; slot < capacity(); ++slot) {
+    PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
+    if (!k.alive || k.segment != segment) continue;
+    k.T_o_k.t = center + s * (k.T_o_k.t - center);
+    k.T_w_k = T_w_o * k.T_o_k;
+    PlacePoint* points = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
+    for (int i = 0; i < k.point_count; ++i) points[i].p_k *= static_cast<float>(s);
+  }
+}
+
 int32_t PlaceMap::createSegment(const SE3& T_w_o) {
   if (segment_count_ == kMaxSegments) return -1;
   segment_T_w_o_[static_cast<std::size_t>(segment_count_)] = T_w_o;

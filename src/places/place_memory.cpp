@@ -19,6 +19,8 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
 void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry,
                                 PoseEstimate& out) {
   followSegment(odometry);
+  // Before the keyframes settled in this frame join: they are in the new unit already.
+  for (const Odometry::Rescale& r : odometry.rescales()) map_.rescaleSegment(segment_, r.s, r.center);
   for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
   if (out.state != TrackingState::Tracking && map_.size() > 0 && segment_ >= 0)
     relocalize(frame, frame_index, odometry, out);
@@ -78,7 +80,9 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   words_.compute(vocabulary_, kf.features);
   database_.insert(slot, words_.bow());
   ++stats_.keyframes;
-  if (options_.loop_closure) {
+  // SE(3) closures need a metric map: one whose unit is not known yet (or never will be: one camera) would need
+  // Sim(3), which is not built yet.
+  if (options_.loop_closure && odometry.rigState().metric()) {
     loop_closer_.setRig(odometry.trackingRig());
     if (loop_closer_.onKeyframe(slot, kf.features, words_, map_, database_)) ++world_revision_;
   }

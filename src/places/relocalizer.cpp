@@ -201,6 +201,7 @@ bool Relocalizer::verify(const FrameFeatures& frame, const FrameWords& words, co
   result.T_w_b = refined.T_w_b;
   result.keyframe = keyframe;
   result.inliers = refined.num_inliers;
+  result.information = refined.information;
   return true;
 }
 

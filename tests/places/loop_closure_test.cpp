@@ -66,10 +66,10 @@ class LoopClosure : public ::testing::Test {
     const std::string sim = test::binPath("mcslam-sim") + " --rig isec --world indoor --no-depth --quiet ";
     ASSERT_EQ(test::runCommand(sim + "--cameras 0 --frames 11 --out " + dir_->file("start"), &out), 0) << out;
     writeOutAndBack(readTumTrajectory(dir_->file("start/groundtruth.txt")), dir_->file("route.txt"));
-    ASSERT_EQ(test::runCommand(sim + "--cameras 1,2,3 --trajectory file:" + dir_->file("route.txt") + " --out " +
-                                   dir_->file("seq"),
-                               &out),
-              0)
+    ASSERT_EQ(
+        test::runCommand(
+            sim + "--cameras 1,2,3 --trajectory file:" + dir_->file("route.txt") + " --out " + dir_->file("seq"), &out),
+        0)
         << out;
   }
   static void TearDownTestSuite() { dir_.reset(); }
@@ -81,8 +81,8 @@ class LoopClosure : public ::testing::Test {
   static Run run(const std::string& tag, const std::string& options) {
     Run r;
     const std::string kf = dir_->file(tag + ".kf.tum"), stats = dir_->file(tag + ".json");
-    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --keyframes " +
-                                   kf + " --stats " + stats + " " + options,
+    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") +
+                                   " --quiet --keyframes " + kf + " --stats " + stats + " " + options,
                                &r.log),
               0)
         << r.log;

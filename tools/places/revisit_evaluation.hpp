@@ -18,7 +18,7 @@ struct RevisitOptions {
   double revisit_distance_m = 2;
   double revisit_angle_deg = 30;
   int max_words_per_place = 2000;  // PlacesOptions' default
-  std::vector<int> cameras;         // subset of the rig (empty: all)
+  std::vector<int> cameras;        // subset of the rig (empty: all)
 };
 
 struct RevisitQuery {

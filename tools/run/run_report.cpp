@@ -147,6 +147,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     const LoopStats& l = places->loopStats();
     j.key("loop_queries").value(l.queries);
     j.key("loops_verified").value(l.verified);
+    j.key("loops_consistent").value(l.consistent);
     j.key("loop_closures").value(l.closures);
     j.key("map_merges").value(l.merges);
     j.key("world_revision").value(static_cast<unsigned long long>(places->worldRevision()));

@@ -79,6 +79,14 @@ class Odometry {
     return {settled_.data(), static_cast<std::size_t>(settled_count_)};
   }
 
+  // The map's unit changed (a rig without overlap found or followed its scale): positions p became
+  // center + s (p - center). Those of the last process(), in order; valid until the next call.
+  struct Rescale {
+    double s = 1;
+    Vec3 center = Vec3::Zero();
+  };
+  std::span<const Rescale> rescales() const { return {rescales_.data(), static_cast<std::size_t>(rescale_count_)}; }
+
   const OdometryStats& stats() const { return stats_; }
   const OdometryTiming& timing() const { return timing_; }
   const Map& map() const { return map_; }
@@ -139,6 +147,8 @@ class Odometry {
   Timestamp frame_t_ = 0;     // of the frame being processed
   std::array<int32_t, 4> settled_{};
   int settled_count_ = 0;
+  std::array<Rescale, 4> rescales_{};
+  int rescale_count_ = 0;
   int64_t last_init_reference_ = -1;
   uint64_t frame_index_ = 0;  // of the frame being processed
   OdometryStats stats_;

@@ -18,9 +18,10 @@ namespace mcslam {
 
 struct LoopStats {
   uint64_t queries = 0;
-  uint64_t verified = 0;   // candidates that passed verification (before the consistency check)
-  uint64_t closures = 0;   // accepted: the map was corrected
-  uint64_t merges = 0;     // closures that joined two segments
+  uint64_t verified = 0;    // candidates that passed verification (before the consistency check)
+  uint64_t consistent = 0;  // confirmed, but the map already agreed with them within their uncertainty
+  uint64_t closures = 0;    // accepted: the map was corrected
+  uint64_t merges = 0;      // closures that joined two segments
   int64_t last_keyframe = -1, last_candidate = -1;  // place keyframe ids of the last closure
   double last_correction_m = 0, last_correction_deg = 0;
   double last_solve_ms = 0;
@@ -42,6 +43,7 @@ class LoopCloser {
   struct LoopEdge {
     int64_t a = -1, b = -1;  // place keyframe ids
     SE3 T_a_b;
+    Vec6 sigma = Vec6::Ones();
   };
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
   void correct(PlaceMap& map);

@@ -60,6 +60,9 @@ class PlaceMap {
 
   const PlaceKeyframe& keyframe(int slot) const { return keyframes_[static_cast<std::size_t>(slot)]; }
   void setKeyframePose(int slot, const SE3& T_w_k) { keyframes_[static_cast<std::size_t>(slot)].T_w_k = T_w_k; }
+  // The segment's odometry took a new unit (positions p became center + s (p - center) in its frame): its
+  // keyframes' odometry and world poses and their points follow.
+  void rescaleSegment(int32_t segment, double s, const Vec3& center);
   std::span<const PlacePoint> points(int slot) const {
     return {points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_),
             static_cast<std::size_t>(keyframes_[static_cast<std::size_t>(slot)].point_count)};

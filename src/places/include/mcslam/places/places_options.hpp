@@ -31,6 +31,11 @@ struct PlacesOptions {
   bool loop_closure = true;
   int loop_min_keyframes_apart = 30;  // an older keyframe of the same segment is a loop candidate only this far back
   int max_loops = 500;                // loop edges kept in the pose graph
+  // Least standard deviations of a loop's relative pose: the place map's points are triangulated to about 1% of
+  // their depth, a few centimetres indoors, and a pose on them is no better. A loop whose correction lies within
+  // its uncertainty changes nothing.
+  double loop_sigma_translation = 0.02;
+  double loop_sigma_rotation_deg = 0.5;
 
   // Relocalization: how long the odometry stays lost, trying to relocalize, before it starts a new map.
   double relocalization_timeout_s = 3.0;

@@ -35,8 +35,9 @@ struct RelocalizationResult {
   SE3 T_w_b;
   int keyframe = -1;  // the candidate that verified (slot)
   int inliers = 0;
-  int candidates = 0;  // verified (tried)
-  float score = 0;     // the database score of the winning candidate
+  int candidates = 0;               // verified (tried)
+  float score = 0;                  // the database score of the winning candidate
+  Mat6 information = Mat6::Zero();  // of T_w_b given the candidate's points ([rho; phi], right perturbation)
 };
 
 class Relocalizer {

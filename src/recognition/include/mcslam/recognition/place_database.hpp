@@ -82,9 +82,9 @@ class PlaceDatabase {
 
   int max_words_per_place_ = 0;
   int stored_ = 0;
-  std::vector<int32_t> head_;           // per word: its head block, -1 when none
-  std::vector<Block> blocks_;           // the pool
-  std::vector<int32_t> free_blocks_;    // a stack of unused block indices
+  std::vector<int32_t> head_;         // per word: its head block, -1 when none
+  std::vector<Block> blocks_;         // the pool
+  std::vector<int32_t> free_blocks_;  // a stack of unused block indices
   int free_block_count_ = 0;
   std::vector<WordId> words_of_;        // place p's words: [p * max_words_per_place_, +word_count_of_[p])
   std::vector<int32_t> word_count_of_;  // per place: words stored, -1 when the slot is empty
