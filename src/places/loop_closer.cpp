@@ -130,9 +130,36 @@ bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& co
 }
 
 void LoopCloser::correct(PlaceMap& map) {
+  buildGraph(map);
+  graph_.optimize();
+  for (int node = 0; node < graph_.nodes(); ++node)
+    map.setKeyframePose(slot_of_node_[static_cast<std::size_t>(node)], graph_.pose(node));
+  // Each segment's odometry frame follows its newest keyframe: the odometry goes on from where the map now puts it.
+  for (int32_t s = 0; s < map.segments(); ++s) {
+    const int newest = segmentEnd(map, s, /*oldest=*/false);
+    if (newest >= 0) map.setSegmentPose(s, map.keyframe(newest).T_w_k * map.keyframe(newest).T_o_k.inverse());
+  }
+}
+
+int LoopCloser::segmentEnd(const PlaceMap& map, int32_t segment, bool oldest) const {
+  for (int slot = 0; slot < map.capacity(); ++slot) {
+    const PlaceKeyframe& k = map.keyframe(slot);
+    if (k.alive && k.segment == segment && (oldest ? k.previous : k.next) < 0) return slot;
+  }
+  return -1;
+}
+
+int LoopCloser::slotOfId(const PlaceMap& map, int64_t id) const {
+  for (int slot = 0; slot < map.capacity(); ++slot)
+    if (map.keyframe(slot).alive && map.keyframe(slot).id == id) return slot;
+  return -1;
+}
+
+// Nodes: every place keyframe, in slot order. Edges: consecutive keyframes of a segment (the odometry's relative
+// pose), and the loops. Each set of segments joined by loops is held by the oldest keyframe of its root segment.
+void LoopCloser::buildGraph(const PlaceMap& map) {
   graph_.clear();
   std::fill(node_of_slot_.begin(), node_of_slot_.end(), -1);
-  // Nodes in slot order; each connected set of segments is held by the first keyframe of its lowest segment.
   for (int slot = 0; slot < map.capacity(); ++slot) {
     const PlaceKeyframe& k = map.keyframe(slot);
     if (!k.alive) continue;
@@ -141,13 +168,8 @@ void LoopCloser::correct(PlaceMap& map) {
     slot_of_node_[static_cast<std::size_t>(node)] = slot;
   }
   for (int32_t s = 0; s < map.segments(); ++s) {
-    // The oldest keyframe of the segment whose root it is holds the gauge of the joined set.
     if (findRoot(segment_root_, s) != s) continue;
-    int oldest = -1;
-    for (int slot = 0; slot < map.capacity(); ++slot) {
-      const PlaceKeyframe& k = map.keyframe(slot);
-      if (k.alive && k.segment == s && k.previous < 0) oldest = slot;
-    }
+    const int oldest = segmentEnd(map, s, /*oldest=*/true);
     if (oldest >= 0) graph_.setFixed(node_of_slot_[static_cast<std::size_t>(oldest)], true);
   }
   for (int slot = 0; slot < map.capacity(); ++slot) {
@@ -159,28 +181,10 @@ void LoopCloser::correct(PlaceMap& map) {
   }
   for (int i = 0; i < loop_count_; ++i) {
     const LoopEdge& e = loops_[static_cast<std::size_t>(i)];
-    int a = -1, b = -1;
-    for (int slot = 0; slot < map.capacity() && (a < 0 || b < 0); ++slot) {
-      const PlaceKeyframe& k = map.keyframe(slot);
-      if (!k.alive) continue;
-      if (k.id == e.a) a = slot;
-      if (k.id == e.b) b = slot;
-    }
+    const int a = slotOfId(map, e.a), b = slotOfId(map, e.b);
     if (a >= 0 && b >= 0)
       graph_.addEdge(node_of_slot_[static_cast<std::size_t>(a)], node_of_slot_[static_cast<std::size_t>(b)], e.T_a_b,
                      e.sigma);
-  }
-  graph_.optimize();
-  for (int node = 0; node < graph_.nodes(); ++node)
-    map.setKeyframePose(slot_of_node_[static_cast<std::size_t>(node)], graph_.pose(node));
-  // Each segment's odometry frame follows its newest keyframe: the odometry goes on from where the map now puts it.
-  for (int32_t s = 0; s < map.segments(); ++s) {
-    int newest = -1;
-    for (int slot = 0; slot < map.capacity(); ++slot) {
-      const PlaceKeyframe& k = map.keyframe(slot);
-      if (k.alive && k.segment == s && k.next < 0) newest = slot;
-    }
-    if (newest >= 0) map.setSegmentPose(s, map.keyframe(newest).T_w_k * map.keyframe(newest).T_o_k.inverse());
   }
 }
 

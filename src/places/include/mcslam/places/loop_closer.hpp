@@ -46,7 +46,11 @@ class LoopCloser {
     Vec6 sigma = Vec6::Ones();
   };
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
+  // Solves the pose graph of the whole map with the loops so far; keyframes and segments' frames take the solution.
   void correct(PlaceMap& map);
+  void buildGraph(const PlaceMap& map);
+  int segmentEnd(const PlaceMap& map, int32_t segment, bool oldest) const;  // slot, -1 when the segment is empty
+  int slotOfId(const PlaceMap& map, int64_t id) const;
 
   PlacesOptions options_;
   Relocalizer verifier_;
