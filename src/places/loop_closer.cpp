@@ -73,6 +73,10 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
     return false;
   }
   ++stats_.verified;
+  if (!closesALoop(map, r.keyframe, slot)) {
+    pending_keyframe_ = -1;
+    return false;
+  }
   const SE3 correction = r.T_w_b * k.T_w_k.inverse();  // moves the drifted keyframe onto the recognized place
   const int64_t candidate = map.keyframe(r.keyframe).id;
   const bool confirmed = consistentWithLast(slot, map, correction);
@@ -116,6 +120,20 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
       stats_.last_correction_deg, stats_.last_solve_ms);
   pending_keyframe_ = -1;
   return true;
+}
+
+// A loop returns: within one segment, the path from the candidate to this keyframe must be much longer than
+// their separation. Seeing a place far down a straight corridor again, after driving towards it, is tracking,
+// not a loop, and its measurement (points far away) is the weakest there is. Another segment always closes one.
+bool LoopCloser::closesALoop(const PlaceMap& map, int candidate, int slot) const {
+  const PlaceKeyframe& c = map.keyframe(candidate);
+  const PlaceKeyframe& k = map.keyframe(slot);
+  if (c.segment != k.segment) return true;
+  double path = 0;
+  for (int s = candidate; s != slot && map.keyframe(s).next >= 0; s = map.keyframe(s).next)
+    path += (map.keyframe(map.keyframe(s).next).T_o_k.t - map.keyframe(s).T_o_k.t).norm();
+  const double separation = (k.T_o_k.t - c.T_o_k.t).norm();
+  return path > options_.loop_min_path_ratio * separation + options_.loop_min_path_m;
 }
 
 // The detection of the keyframe before this one (same segment) found a correction that agrees with this one.

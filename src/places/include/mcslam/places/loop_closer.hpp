@@ -46,6 +46,7 @@ class LoopCloser {
     Vec6 sigma = Vec6::Ones();
   };
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
+  bool closesALoop(const PlaceMap& map, int candidate, int slot) const;
   // Solves the pose graph of the whole map with the loops so far; keyframes and segments' frames take the solution.
   void correct(PlaceMap& map);
   void buildGraph(const PlaceMap& map);

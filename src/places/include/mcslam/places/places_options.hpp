@@ -31,6 +31,10 @@ struct PlacesOptions {
   bool loop_closure = true;
   int loop_min_keyframes_apart = 30;  // an older keyframe of the same segment is a loop candidate only this far back
   int max_loops = 500;                // loop edges kept in the pose graph
+  // Within one odometry map, a loop's path from the old keyframe to the new one is longer than this many times
+  // their separation plus this many metres (a return, not a look far ahead).
+  double loop_min_path_ratio = 3.0;
+  double loop_min_path_m = 2.0;
   // Least standard deviations of a loop's relative pose: the place map's points are triangulated to about 1% of
   // their depth, a few centimetres indoors, and a pose on them is no better. A loop whose correction lies within
   // its uncertainty changes nothing.
