@@ -3,9 +3,9 @@
 // neighbours in its segment, whose points overlap it) is verified by matching the frame's keypoints, of every
 // camera, to its points within the same vocabulary node (Hamming distance, ratio test across distinct landmarks),
 // generalized P3P in RANSAC over the rig's rays, then a guided search (every point of the group projected into
-// every camera at that pose, matched within a radius) and refinement on all of it. The first candidate with
-// `min_inliers` inliers after the guided search gives the frame's world pose: repeated texture can give a wrong
-// RANSAC consensus of a few dozen matches, never the hundreds a right pose finds by projection.
+// every camera at that pose, matched within a radius) and refinement on all of it. The first candidate that passes
+// the acceptance rule after the guided search gives the frame's world pose: repeated texture can make a wrong
+// RANSAC consensus, which the guided search does not confirm (docs/design/places.md).
 // Fixed memory: every buffer is sized at construction.
 #include <span>
 #include <vector>
