@@ -42,7 +42,6 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
     return;
   }
   segment_ = s;
-  ++stats_.segments;
 }
 
 void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {

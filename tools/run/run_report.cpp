@@ -142,7 +142,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("keyframes_dropped").value(p.keyframes_dropped);
     j.key("relocalization_queries").value(p.relocalization_queries);
     j.key("relocalizations").value(p.relocalizations);
-    j.key("segments").value(p.segments);
+    j.key("segments").value(places->map().segments());  // odometry maps started, the first one included
     j.key("last_relocalized_frame").value(static_cast<long long>(p.last_relocalized_frame));
     const LoopStats& l = places->loopStats();
     j.key("loop_queries").value(l.queries);

@@ -24,7 +24,6 @@ struct PlaceStats {
   uint64_t keyframes_dropped = 0;          // not added: the map was full
   uint64_t relocalization_queries = 0;     // lost frames that queried the database
   uint64_t relocalizations = 0;            // ... and were found
-  uint64_t segments = 0;                   // odometry maps started (the first one included)
   int64_t last_relocalized_keyframe = -1;  // id of the place keyframe the last relocalization verified on
   int64_t last_relocalized_frame = -1;     // frame index of the last relocalization
 };
