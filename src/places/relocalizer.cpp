@@ -27,6 +27,7 @@ AbsolutePoseRansacOptions ransacOptions() {
 Relocalizer::Relocalizer(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera)
     : rig_(rig),
       options_(options),
+      octave_sigma_(scale_factor),
       candidates_(static_cast<std::size_t>(options.max_candidates)),
       group_(static_cast<std::size_t>(2 * options.neighbour_keyframes + 1)),
       matches_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
@@ -34,7 +35,6 @@ Relocalizer::Relocalizer(const Rig& rig, const PlacesOptions& options, float sca
       inliers_(matches_.size()),
       ransac_(rig, rig.size() * max_features_per_camera, ransacOptions()),
       refiner_(rig, rig.size() * max_features_per_camera) {
-  for (int o = 0; o < 32; ++o) octave_sigma_.push_back(std::pow(scale_factor, static_cast<float>(o)));
   const auto per_camera = static_cast<std::size_t>(max_features_per_camera);
   for (int c = 0; c < rig.size(); ++c) {
     grids_.emplace_back(rig.model(c).width(), rig.model(c).height(), kGridCell, max_features_per_camera);
@@ -70,8 +70,7 @@ int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& 
         const Vec3 p_c = T_c_k * p.p_k.cast<double>();
         Vec2 uv;
         if (p_c.z() <= 0 || !model.project(p_c, uv) || !model.inImage(uv, 0)) continue;
-        const double radius =
-            kSearchRadiusPx * octave_sigma_[static_cast<std::size_t>(std::clamp<int>(p.octave, 0, 31))];
+        const double radius = kSearchRadiusPx * octave_sigma_[p.octave];
         grids_[static_cast<std::size_t>(c)].forEachNear(uv.x(), uv.y(), radius, [&](const KeypointGrid::Entry& e) {
           if ((Vec2(e.x, e.y) - uv).squaredNorm() > radius * radius) return;
           const int d = hammingDistance(p.descriptor, set.descriptors[static_cast<std::size_t>(e.index)]);
@@ -107,7 +106,7 @@ void Relocalizer::addMatch(const FrameFeatures& frame, const PlaceMap& map, int 
   matches_[static_cast<std::size_t>(count)] = {static_cast<int16_t>(c), k, p_w, point};
   observations_[static_cast<std::size_t>(count)] = makePoseObservation(
       rig_, c, Vec2(kp.x, kp.y), frame.bearings[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)], p_w,
-      octave_sigma_[static_cast<std::size_t>(std::clamp<int>(kp.octave, 0, 31))]);
+      octave_sigma_[kp.octave]);
   ++count;
 }
 

@@ -12,6 +12,7 @@
 
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/features/frame_features.hpp"
+#include "mcslam/features/octave_scales.hpp"
 #include "mcslam/geometry/absolute_pose_ransac.hpp"
 #include "mcslam/geometry/pose_refinement.hpp"
 #include "mcslam/odometry/keypoint_grid.hpp"
@@ -90,7 +91,7 @@ class Relocalizer {
 
   Rig rig_;
   PlacesOptions options_;
-  std::vector<float> octave_sigma_;
+  OctaveScales octave_sigma_;  // keypoint sigma by octave, pixels
   std::vector<PlaceScore> candidates_;
   std::vector<int32_t> group_;
   int group_count_ = 0;
