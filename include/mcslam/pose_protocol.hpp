@@ -15,7 +15,7 @@ inline constexpr uint16_t kProtocolVersion = 1;
 inline constexpr std::size_t kPacketSize = 104;
 
 // Mirrors mcslam::TrackingState (kept separate so consumers need no other header).
-enum class Tracking : uint8_t { NotInitialized = 0, Tracking = 1, Lost = 2 };
+enum class Tracking : uint8_t { NotInitialized = 0, Tracking = 1, Lost = 2, Localizing = 3 };
 
 inline constexpr uint8_t kFlagValid = 1u << 0;     // position/orientation hold an estimate
 inline constexpr uint8_t kFlagKeyframe = 1u << 1;  // the pipeline made this frame a keyframe
@@ -154,6 +154,7 @@ inline const char* trackingName(Tracking t) {
     case Tracking::NotInitialized: return "not_initialized";
     case Tracking::Tracking: return "tracking";
     case Tracking::Lost: return "lost";
+    case Tracking::Localizing: return "localizing";
   }
   return "unknown";
 }

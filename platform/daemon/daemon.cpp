@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+
 #include "daemon/source_factory.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/synced_file.hpp"
@@ -12,6 +14,7 @@ namespace mcslam::platform {
 static_assert(static_cast<int>(pose::Tracking::NotInitialized) == static_cast<int>(TrackingState::NotInitialized));
 static_assert(static_cast<int>(pose::Tracking::Tracking) == static_cast<int>(TrackingState::Tracking));
 static_assert(static_cast<int>(pose::Tracking::Lost) == static_cast<int>(TrackingState::Lost));
+static_assert(static_cast<int>(pose::Tracking::Localizing) == static_cast<int>(TrackingState::Localizing));
 
 namespace {
 constexpr int64_t kMs = 1000000;
@@ -39,13 +42,15 @@ Daemon::Daemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> proce
       processor_(std::move(processor)),
       source_(source ? std::move(source) : createSource(config)),
       sizes_(imageSizes(config.rig)),
+      map_saver_(prepareMap(config, *processor_)),
       camera_rings_(sizes_, config.capacities.camera_ring_slots),
       rig_ring_(config.capacities.rig_ring_slots, [this](RigFrame& f) { f.allocate(sizes_); }),
       pose_ring_(config.capacities.pose_ring_slots),
       trigger_(config.trigger, config.realtime.trigger_priority, *source_, config.file),
       assembly_(sizes_, assemblySettings(config), camera_rings_, rig_ring_, warm_up_),
       processing_(*processor_, config.rig.size(), config.realtime.processing_priority,
-                  static_cast<uint64_t>(config.warmup_frames), rig_ring_, pose_ring_, pressure_, warm_up_),
+                  static_cast<uint64_t>(config.warmup_frames), rig_ring_, pose_ring_, pressure_, warm_up_,
+                  map_saver_.get()),
       publishing_(config, pose_ring_, warm_up_) {
   if (!config.output.extrinsics.empty()) extrinsics_path_ = outputPathFor(config, config.output.extrinsics);
   if (config.realtime.lock_memory) {
@@ -59,6 +64,7 @@ void Daemon::start() {
   if (started_) return;
   started_ = true;
   publishing_.start();
+  if (map_saver_) map_saver_->start();
   processing_.start();
   assembly_.start();
   source_->start(SourceLinks{&camera_rings_, &trigger_.log(), &pressure_, &warm_up_});
@@ -83,11 +89,41 @@ bool Daemon::stop(int64_t grace_ns) {
   else
     processing_.detach();  // stuck inside the pipeline; we still save what was published
   publishing_.stop();
-  if (processing_finished)
+  if (processing_finished) {
     writeRefinedExtrinsics();  // else the pipeline may still be inside process()
-  else if (!extrinsics_path_.empty())
-    spdlog::error("refined extrinsics not written: the pipeline did not stop");
+    if (map_saver_) map_saver_->saveNow(*processor_);
+  } else {
+    if (!extrinsics_path_.empty()) spdlog::error("refined extrinsics not written: the pipeline did not stop");
+    if (map_saver_) spdlog::error("map not saved at stop: the pipeline did not stop (the last periodic save stands)");
+  }
   return processing_finished;
+}
+
+std::unique_ptr<MapSaver> Daemon::prepareMap(const DaemonConfig& config, FrameProcessor& processor) {
+  const MapConfig& m = config.map;
+  if (!m.load.empty()) {
+    const std::string path = outputPathFor(config, m.load);
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) {
+      if (m.localize_only) throw InputError("map.load: " + path + ": no such map to localize in (map.mode localize)");
+      spdlog::info("map.load: no map at {} yet: this run starts one", path);
+    } else {
+      try {
+        processor.loadMap(path, m.localize_only);
+        spdlog::info("map.load: {} loaded{}: poses are in its frame once the rig is recognized in it", path,
+                     m.localize_only ? " (localizing only)" : "");
+      } catch (const InputError& e) {
+        if (!m.start_without_unreadable) throw;
+        // Kept for a post-mortem, and so that the next save does not overwrite it.
+        const std::string aside = path + ".unreadable";
+        std::filesystem::rename(path, aside, ec);
+        spdlog::error("map.load: {}; starting without a map (map.on_unreadable: start_empty); the file is now {}",
+                      e.what(), ec ? path + " (could not be renamed: " + ec.message() + ")" : aside);
+      }
+    }
+  }
+  if (m.save.empty()) return nullptr;
+  return std::make_unique<MapSaver>(outputPathFor(config, m.save), m.save_interval_s, processor.maxMapBytes());
 }
 
 void Daemon::writeRefinedExtrinsics() {
@@ -152,6 +188,11 @@ DaemonStats Daemon::stats() const {
                                  publishing_.allocationsSinceWarmup() + source_->allocationsSinceWarmup();
   }
   s.source_finished = source_->finished();
+  s.places = processing_.placeCounters();
+  if (map_saver_) {
+    s.map_saves = map_saver_->saves();
+    s.map_save_failures = map_saver_->failures();
+  }
   return s;
 }
 

@@ -174,6 +174,19 @@ void readOutput(const YamlFields& out, OutputConfig& o) {
   if (o.trajectory.empty()) out.fail("trajectory", "must not be empty");
 }
 
+void readMap(const YamlFields& m, MapConfig& c) {
+  m.allowOnly({"load", "save", "save_interval_s", "mode", "on_unreadable"});
+  c.load = m.string("load", "");
+  c.save = m.string("save", "");
+  c.save_interval_s = m.number("save_interval_s", c.save_interval_s);
+  if (c.save_interval_s < 0) m.fail("save_interval_s", "must be >= 0 (0: save only at a clean stop)");
+  c.localize_only = m.choice("mode", std::string("slam"), {"slam", "localize"}) == "localize";
+  c.start_without_unreadable = m.choice("on_unreadable", std::string("stop"), {"stop", "start_empty"}) == "start_empty";
+  if (c.localize_only && c.load.empty()) m.fail("mode", "localize needs a map to load (map.load)");
+  if (c.localize_only && !c.save.empty())
+    m.fail("save", "a map only localized in is not changed: no save in mode localize");
+}
+
 void readRealtime(const YamlFields& rt, RealtimeConfig& r) {
   rt.allowOnly({"trigger_priority", "acquisition_priority", "processing_priority", "lock_memory"});
   r.trigger_priority = static_cast<int>(rt.integer("trigger_priority", 0, 0, 99));
@@ -250,7 +263,7 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
   c.file = file;
   const YamlFields top(root, "", file);
   top.allowOnly({"log_level", "status_interval_s", "warmup_frames", "calibration", "source", "trigger", "assembly",
-                 "capacities", "publish", "output", "realtime", "slam"});
+                 "capacities", "publish", "output", "map", "realtime", "slam"});
   c.log_level = top.choice("log_level", c.log_level, {"trace", "debug", "info", "warn", "error", "critical", "off"});
   c.status_interval_s = top.positiveNumber("status_interval_s", c.status_interval_s);
   c.warmup_frames = static_cast<double>(top.integer("warmup_frames", 50, 0, 1000000));
@@ -264,6 +277,7 @@ DaemonConfig parseDaemonConfig(const std::string& yaml_text, const std::string& 
   readCapacities(top.child("capacities"), c.capacities);
   readPublish(top.child("publish"), c.publish);
   readOutput(top.child("output"), c.output);
+  readMap(top.child("map"), c.map);
   readRealtime(top.child("realtime"), c.realtime);
   c.slam = root["slam"] ? root["slam"] : YAML::Node(YAML::NodeType::Map);
   c.rig = resolveRig(c, top);

@@ -96,6 +96,13 @@ void emitOutputs(YAML::Emitter& e, const DaemonConfig& c) {
   e << YAML::Key << "directory" << YAML::Value << c.output.directory;
   e << YAML::Key << "trajectory" << YAML::Value << c.output.trajectory;
   e << YAML::Key << "extrinsics" << YAML::Value << c.output.extrinsics << YAML::EndMap;
+  e << YAML::Key << "map" << YAML::Value << YAML::BeginMap;
+  e << YAML::Key << "load" << YAML::Value << c.map.load;
+  e << YAML::Key << "save" << YAML::Value << c.map.save;
+  e << YAML::Key << "save_interval_s" << YAML::Value << c.map.save_interval_s;
+  e << YAML::Key << "mode" << YAML::Value << (c.map.localize_only ? "localize" : "slam");
+  e << YAML::Key << "on_unreadable" << YAML::Value << (c.map.start_without_unreadable ? "start_empty" : "stop")
+    << YAML::EndMap;
   const auto& r = c.realtime;
   e << YAML::Key << "realtime" << YAML::Value << YAML::BeginMap;
   e << YAML::Key << "trigger_priority" << YAML::Value << r.trigger_priority;

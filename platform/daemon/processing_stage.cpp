@@ -2,13 +2,17 @@
 
 #include <spdlog/spdlog.h>
 
+#include "mcslam/core/time.hpp"
 #include "realtime/scheduling.hpp"
 
 namespace mcslam::platform {
 
 ProcessingStage::ProcessingStage(FrameProcessor& processor, int cameras, int priority, uint64_t warmup_frames,
-                                 RigRing& in, PoseRing& out, BackPressure& pressure, WarmUp& warm_up)
-    : runner_(processor),
+                                 RigRing& in, PoseRing& out, BackPressure& pressure, WarmUp& warm_up,
+                                 MapSaver* map_saver)
+    : processor_(processor),
+      map_saver_(map_saver),
+      runner_(processor),
       priority_(priority),
       warmup_frames_(warmup_frames),
       in_(in),
@@ -98,10 +102,35 @@ void ProcessingStage::handOver(PoseSlot& out, const FrameTag& tag) {
   if (out_.publish()) pose_drops_.fetch_add(1, std::memory_order_relaxed);
   tracking_.store(static_cast<uint8_t>(out.estimate.state), std::memory_order_relaxed);
   unscaled_.store(out.estimate.valid && !out.estimate.metric, std::memory_order_relaxed);
+  afterFrame();
   const uint64_t done = processed_.fetch_add(1, std::memory_order_release) + 1;
   pressure_.done();
   if (!warm_up_.warm() && done >= warmup_frames_) warm_up_.end(done);
   processing_meter_.note(warm_up_.warm());
+}
+
+void ProcessingStage::afterFrame() {
+  PlaceCounters c;
+  if (processor_.placeCounters(c)) {
+    relocalizations_.store(c.relocalizations, std::memory_order_relaxed);
+    loop_closures_.store(c.loop_closures, std::memory_order_relaxed);
+    map_merges_.store(c.map_merges, std::memory_order_relaxed);
+    localization_corrections_.store(c.localization_corrections, std::memory_order_relaxed);
+    place_keyframes_.store(c.keyframes, std::memory_order_relaxed);
+    world_revision_.store(c.world_revision, std::memory_order_relaxed);
+  }
+  if (map_saver_) map_saver_->afterFrame(processor_, monotonicNowNs());
+}
+
+PlaceCounters ProcessingStage::placeCounters() const {
+  PlaceCounters c;
+  c.relocalizations = relocalizations_.load(std::memory_order_relaxed);
+  c.loop_closures = loop_closures_.load(std::memory_order_relaxed);
+  c.map_merges = map_merges_.load(std::memory_order_relaxed);
+  c.localization_corrections = localization_corrections_.load(std::memory_order_relaxed);
+  c.keyframes = place_keyframes_.load(std::memory_order_relaxed);
+  c.world_revision = world_revision_.load(std::memory_order_relaxed);
+  return c;
 }
 
 }  // namespace mcslam::platform

@@ -21,12 +21,17 @@ void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char
                                                  : 0.0;
   std::snprintf(out, size,
                 "%.1f Hz, %s%s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
-                "cameras %s%s",
+                "cameras %s%s, map %lld keyframes, relocalizations %llu, loop closures %llu, merges %llu, "
+                "world revision %u, map saves %llu (failed %llu)",
                 rate_hz, trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "",
                 static_cast<unsigned long long>(s.processed),
                 static_cast<unsigned long long>(s.rig_drops + s.camera_drops),
                 static_cast<unsigned long long>(s.partial_frames), static_cast<double>(s.latency_p50_ns) * 1e-6,
-                per_frame, s.warm ? "" : " (warming up)", health, s.source_finished ? ", source finished" : "");
+                per_frame, s.warm ? "" : " (warming up)", health, s.source_finished ? ", source finished" : "",
+                static_cast<long long>(s.places.keyframes), static_cast<unsigned long long>(s.places.relocalizations),
+                static_cast<unsigned long long>(s.places.loop_closures),
+                static_cast<unsigned long long>(s.places.map_merges), static_cast<unsigned>(s.places.world_revision),
+                static_cast<unsigned long long>(s.map_saves), static_cast<unsigned long long>(s.map_save_failures));
 }
 
 namespace {
@@ -51,7 +56,7 @@ class Watch {
     if (now - last_status_ >= status_ns_) {
       const double rate =
           static_cast<double>(s.processed - processed_at_status_) / (static_cast<double>(now - last_status_) * 1e-9);
-      char line[400];
+      char line[640];
       formatStatus(s, rate, health, line, sizeof(line));
       notifier.status(line);
       spdlog::info("{}", line);

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "mcslam/core/binary_io.hpp"
+
 namespace mcslam {
 
 OdometryOptions effectiveOdometryOptions(const PipelineConfig& config, const OverlapMap& overlap) {
@@ -95,6 +97,28 @@ void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {
   computeFeatures(frame, features_, timing_);
   track(features_, frame.sequence, frame.t, out, timing_);
   timing_.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void SlamPipeline::loadMap(const std::string& path, bool localize_only) {
+  if (!places_) throw InputError(path + ": a map needs place memory, which places.enabled turns off");
+  places_->readMap(readFileBounded(path, kMaxMapFileBytes, "map file"), path, localize_only);
+}
+
+bool SlamPipeline::placeCounters(PlaceCounters& out) const {
+  if (!places_) return false;
+  out.relocalizations = places_->stats().relocalizations;
+  out.loop_closures = places_->loopStats().closures;
+  out.map_merges = places_->loopStats().merges;
+  out.localization_corrections = places_->stats().localization_corrections;
+  out.keyframes = places_->map().size();
+  out.world_revision = places_->worldRevision();
+  return true;
+}
+
+bool SlamPipeline::writeMap(std::string& out) const {
+  if (!places_) return false;
+  places_->writeMap(out);
+  return true;
 }
 
 void SlamPipeline::keyframes(std::vector<KeyframePose>& out) const {

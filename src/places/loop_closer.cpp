@@ -2,9 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
-#include <Eigen/LU>
 #include <chrono>
 #include <cmath>
+
+#include "pose_io.hpp"
 
 namespace mcslam {
 
@@ -21,26 +22,14 @@ Vec6 odometrySigma(const SE3& T_a_b) {
   return s;
 }
 
-// A verified loop: the relative pose's standard deviations from the refinement's information, which takes the
-// candidate's points as exact: not below the floors (the points' own errors; PlacesOptions). Points far away leave
-// the translation along the view loosely known, and the edge says so.
-Vec6 loopSigma(const Mat6& information, const PlacesOptions& o) {
-  Vec6 s;
-  const Eigen::FullPivLU<Mat6> lu(information);
-  const Vec6 variance = lu.isInvertible() ? Vec6(lu.inverse().diagonal()) : Vec6::Constant(1e6);
-  for (int k = 0; k < 6; ++k) s[k] = std::sqrt(std::max(variance[k], 0.0));
-  s.head<3>() = s.head<3>().cwiseMax(o.loop_sigma_translation);
-  s.tail<3>() = s.tail<3>().cwiseMax(o.loop_sigma_rotation_deg * M_PI / 180.0);
-  return s;
-}
+}  // namespace
 
-int32_t findRoot(std::vector<int32_t>& root, int32_t s) {
+int32_t LoopCloser::findRoot(int32_t s) {
+  std::vector<int32_t>& root = segment_root_;
   while (root[static_cast<std::size_t>(s)] != s)
     s = root[static_cast<std::size_t>(s)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(s)])];
   return s;
 }
-
-}  // namespace
 
 LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera)
     : options_(options),
@@ -87,8 +76,8 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
   if (!confirmed) return false;
   // A correction within the loop measurement's own uncertainty (chi-square, 6 dof, 95%) says the map is consistent
   // already: moving the world for it would only add the measurement's noise to every published pose.
-  const Vec6 sigma = loopSigma(r.information, options_);
-  if (correction.log().cwiseQuotient(sigma).squaredNorm() < 12.59) {
+  const Vec6 sigma = verifiedPoseSigma(r, options_);
+  if (withinUncertainty(correction, sigma)) {
     ++stats_.consistent;
     pending_keyframe_ = -1;
     return false;
@@ -99,8 +88,8 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
   }
   loops_[static_cast<std::size_t>(loop_count_++)] = {candidate, k.id,
                                                      map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b, sigma};
-  const int32_t root_k = findRoot(segment_root_, k.segment);
-  const int32_t root_c = findRoot(segment_root_, map.keyframe(r.keyframe).segment);
+  const int32_t root_k = findRoot(k.segment);
+  const int32_t root_c = findRoot(map.keyframe(r.keyframe).segment);
   if (root_k != root_c) {
     segment_root_[static_cast<std::size_t>(std::max(root_k, root_c))] = std::min(root_k, root_c);
     ++stats_.merges;
@@ -142,9 +131,8 @@ bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& co
   if (pending_keyframe_ < 0 || pending_segment_ != k.segment || k.previous < 0 ||
       map.keyframe(k.previous).id != pending_keyframe_)
     return false;
-  const SE3 difference = pending_correction_.inverse() * correction;
-  const double distance = std::max(1.0, (k.T_w_k.t - map.keyframe(k.previous).T_w_k.t).norm() + correction.t.norm());
-  return difference.t.norm() < 0.05 * distance && so3Log(difference.R).norm() < 2.0 * M_PI / 180.0;
+  return sameCorrection(pending_correction_, correction,
+                        (k.T_w_k.t - map.keyframe(k.previous).T_w_k.t).norm() + correction.t.norm());
 }
 
 void LoopCloser::correct(PlaceMap& map) {
@@ -175,6 +163,46 @@ int LoopCloser::slotOfId(const PlaceMap& map, int64_t id) const {
 
 // Nodes: every place keyframe, in slot order. Edges: consecutive keyframes of a segment (the odometry's relative
 // pose), and the loops. Each set of segments joined by loops is held by the oldest keyframe of its root segment.
+constexpr std::size_t kLoopBytes = 2 * sizeof(int64_t) + 12 * sizeof(double) + 6 * sizeof(double);
+
+std::size_t LoopCloser::maxWrittenBytes() const {
+  return sizeof(uint32_t) + loops_.size() * kLoopBytes + PlaceMap::kMaxSegments * sizeof(int32_t);
+}
+
+void LoopCloser::write(ByteWriter& out, int segments) const {
+  out.put<uint32_t>(static_cast<uint32_t>(loop_count_));
+  for (int i = 0; i < loop_count_; ++i) {
+    const LoopEdge& e = loops_[static_cast<std::size_t>(i)];
+    out.put<int64_t>(e.a);
+    out.put<int64_t>(e.b);
+    putPose(out, e.T_a_b);
+    for (int k = 0; k < 6; ++k) out.put<double>(e.sigma[k]);
+  }
+  for (int s = 0; s < segments; ++s) out.put<int32_t>(segment_root_[static_cast<std::size_t>(s)]);
+}
+
+void LoopCloser::read(ByteReader& in, int segments) {
+  clear();
+  const auto count = in.take<uint32_t>("the loop count");
+  if (count > loops_.size())
+    in.fail(std::to_string(count) + " loops, more than places.max_loops (" + std::to_string(loops_.size()) + ")");
+  loop_count_ = static_cast<int>(count);
+  for (int i = 0; i < loop_count_; ++i) {
+    LoopEdge& e = loops_[static_cast<std::size_t>(i)];
+    e.a = in.take<int64_t>("a loop's keyframe");
+    e.b = in.take<int64_t>("a loop's keyframe");
+    e.T_a_b = takePose(in, "a loop's relative pose");
+    for (int k = 0; k < 6; ++k) e.sigma[k] = in.take<double>("a loop's uncertainty");
+    if (!(e.sigma.minCoeff() > 0) || !e.sigma.allFinite()) in.fail("a loop with an uncertainty that is not positive");
+  }
+  // Joining always hangs the larger root under the smaller: a root that is not below its segment is no union.
+  for (int s = 0; s < segments; ++s) {
+    const auto r = in.take<int32_t>("a segment's root");
+    if (r < 0 || r > s) in.fail("segment " + std::to_string(s) + " joined to segment " + std::to_string(r));
+    segment_root_[static_cast<std::size_t>(s)] = r;
+  }
+}
+
 void LoopCloser::buildGraph(const PlaceMap& map) {
   graph_.clear();
   std::fill(node_of_slot_.begin(), node_of_slot_.end(), -1);
@@ -186,7 +214,7 @@ void LoopCloser::buildGraph(const PlaceMap& map) {
     slot_of_node_[static_cast<std::size_t>(node)] = slot;
   }
   for (int32_t s = 0; s < map.segments(); ++s) {
-    if (findRoot(segment_root_, s) != s) continue;
+    if (findRoot(s) != s) continue;
     const int oldest = segmentEnd(map, s, /*oldest=*/true);
     if (oldest >= 0) graph_.setFixed(node_of_slot_[static_cast<std::size_t>(oldest)], true);
   }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "pose_io.hpp"
+
 namespace mcslam {
 
 PlaceMap::PlaceMap(int max_keyframes, int max_points_per_keyframe)
@@ -10,7 +12,9 @@ PlaceMap::PlaceMap(int max_keyframes, int max_points_per_keyframe)
       free_(static_cast<std::size_t>(max_keyframes)),
       max_points_(max_points_per_keyframe),
       newest_of_segment_(kMaxSegments, -1),
-      segment_T_w_o_(kMaxSegments) {
+      segment_T_w_o_(kMaxSegments),
+      segment_placed_(kMaxSegments, 0),
+      file_position_(static_cast<std::size_t>(max_keyframes)) {
   clear();
 }
 
@@ -93,10 +97,148 @@ void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {
   }
 }
 
-int32_t PlaceMap::createSegment(const SE3& T_w_o) {
+int32_t PlaceMap::createSegment(const SE3& T_w_o, bool placed) {
   if (segment_count_ == kMaxSegments) return -1;
   segment_T_w_o_[static_cast<std::size_t>(segment_count_)] = T_w_o;
+  segment_placed_[static_cast<std::size_t>(segment_count_)] = placed ? 1 : 0;
   return segment_count_++;
+}
+
+void PlaceMap::moveSegment(int32_t segment, const SE3& T_w_o) {
+  segment_T_w_o_[static_cast<std::size_t>(segment)] = T_w_o;
+  for (PlaceKeyframe& k : keyframes_)
+    if (k.alive && k.segment == segment) k.T_w_k = T_w_o * k.T_o_k;
+}
+
+namespace {
+
+constexpr std::size_t kPoseBytes = 12 * sizeof(double);
+constexpr std::size_t kPointBytes =
+    3 * sizeof(float) + sizeof(int32_t) + sizeof(int16_t) + sizeof(int8_t) + sizeof(int64_t) + sizeof(Descriptor);
+constexpr std::size_t kKeyframeBytes = sizeof(int64_t) + sizeof(int32_t) + sizeof(int64_t) + sizeof(uint64_t) +
+                                       2 * kPoseBytes + 2 * sizeof(int32_t) + sizeof(uint32_t);
+
+}  // namespace
+
+std::size_t PlaceMap::maxWrittenBytes() const {
+  return sizeof(int64_t) + sizeof(uint32_t) + kMaxSegments * (kPoseBytes + 1) + sizeof(uint32_t) +
+         static_cast<std::size_t>(capacity()) * (kKeyframeBytes + static_cast<std::size_t>(max_points_) * kPointBytes);
+}
+
+void PlaceMap::write(ByteWriter& out) const {
+  out.put<int64_t>(next_id_);
+  out.put<uint32_t>(static_cast<uint32_t>(segment_count_));
+  for (int s = 0; s < segment_count_; ++s) {
+    putPose(out, segment_T_w_o_[static_cast<std::size_t>(s)]);
+    out.put<uint8_t>(segment_placed_[static_cast<std::size_t>(s)]);
+  }
+  // Links as positions in the file: the reader puts the i-th keyframe written into slot i.
+  std::vector<int32_t>& position = file_position_;
+  int count = 0;
+  for (int slot = 0; slot < capacity(); ++slot)
+    position[static_cast<std::size_t>(slot)] = keyframes_[static_cast<std::size_t>(slot)].alive ? count++ : -1;
+  out.put<uint32_t>(static_cast<uint32_t>(count));
+  const auto linked = [&](int32_t slot) { return slot < 0 ? -1 : position[static_cast<std::size_t>(slot)]; };
+  for (int slot = 0; slot < capacity(); ++slot) {
+    const PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
+    if (!k.alive) continue;
+    out.put<int64_t>(k.id);
+    out.put<int32_t>(k.segment);
+    out.put<int64_t>(k.t);
+    out.put<uint64_t>(k.frame_index);
+    putPose(out, k.T_w_k);
+    putPose(out, k.T_o_k);
+    out.put<int32_t>(linked(k.previous));
+    out.put<int32_t>(linked(k.next));
+    out.put<uint32_t>(static_cast<uint32_t>(k.point_count));
+    for (const PlacePoint& p : points(slot)) {
+      for (int i = 0; i < 3; ++i) out.put<float>(p.p_k[i]);
+      out.put<int32_t>(p.node);
+      out.put<int16_t>(p.cam);
+      out.put<int8_t>(p.octave);
+      out.put<int64_t>(p.landmark_id);
+      out.putBytes(p.descriptor.data(), sizeof(Descriptor));
+    }
+  }
+}
+
+void PlaceMap::read(ByteReader& in, int cameras) {
+  clear();
+  next_id_ = in.take<int64_t>("the next keyframe id");
+  const auto segments = in.take<uint32_t>("the segment count");
+  if (segments > static_cast<uint32_t>(kMaxSegments))
+    in.fail(std::to_string(segments) + " odometry maps (segments), more than the " + std::to_string(kMaxSegments) +
+            " a map holds");
+  segment_count_ = static_cast<int>(segments);
+  for (int s = 0; s < segment_count_; ++s) {
+    segment_T_w_o_[static_cast<std::size_t>(s)] = takePose(in, "a segment's pose");
+    segment_placed_[static_cast<std::size_t>(s)] = in.take<uint8_t>("a segment's placement") != 0 ? 1 : 0;
+  }
+  const auto count = in.take<uint32_t>("the keyframe count");
+  if (count > static_cast<uint32_t>(capacity()))
+    in.fail(std::to_string(count) + " keyframes, more than places.max_keyframes (" + std::to_string(capacity()) + ")");
+  const int n = static_cast<int>(count);
+  for (int slot = 0; slot < n; ++slot) {
+    PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
+    k.alive = true;
+    k.id = in.take<int64_t>("a keyframe id");
+    k.segment = in.take<int32_t>("a keyframe's segment");
+    k.t = in.take<int64_t>("a keyframe's time");
+    k.frame_index = in.take<uint64_t>("a keyframe's frame");
+    k.T_w_k = takePose(in, "a keyframe's world pose");
+    k.T_o_k = takePose(in, "a keyframe's odometry pose");
+    k.previous = in.take<int32_t>("a keyframe's predecessor");
+    k.next = in.take<int32_t>("a keyframe's successor");
+    const auto points = in.take<uint32_t>("a keyframe's point count");
+    if (k.id < 0 || k.id >= next_id_ || k.segment < 0 || k.segment >= segment_count_ || k.previous < -1 ||
+        k.previous >= n || k.next < -1 || k.next >= n)
+      in.fail("keyframe " + std::to_string(k.id) + " (segment " + std::to_string(k.segment) + ", neighbours " +
+              std::to_string(k.previous) + " and " + std::to_string(k.next) + ") does not belong to this map");
+    if (points > static_cast<uint32_t>(max_points_))
+      in.fail("keyframe " + std::to_string(k.id) + " has " + std::to_string(points) +
+              " points, more than places.max_points_per_keyframe (" + std::to_string(max_points_) + ")");
+    k.point_count = static_cast<int32_t>(points);
+    PlacePoint* out = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
+    for (uint32_t i = 0; i < points; ++i) {
+      PlacePoint& p = out[i];
+      for (int j = 0; j < 3; ++j) p.p_k[j] = in.take<float>("a point's position");
+      p.node = in.take<int32_t>("a point's node");
+      p.cam = in.take<int16_t>("a point's camera");
+      p.octave = in.take<int8_t>("a point's octave");
+      p.landmark_id = in.take<int64_t>("a point's landmark");
+      in.takeBytes(p.descriptor.data(), sizeof(Descriptor), "a point's descriptor");
+      if (!p.p_k.allFinite() || p.cam < 0 || p.cam >= cameras || p.octave < 0 || p.node < 0)
+        in.fail("keyframe " + std::to_string(k.id) + " has a point of camera " + std::to_string(p.cam) + ", octave " +
+                std::to_string(p.octave) + " that this " + std::to_string(cameras) + "-camera rig cannot have");
+    }
+    if (k.next < 0) newest_of_segment_[static_cast<std::size_t>(k.segment)] = slot;
+    if (newest_ < 0 || k.id > keyframes_[static_cast<std::size_t>(newest_)].id) newest_ = slot;
+  }
+  live_ = n;
+  free_count_ = capacity() - n;
+  for (int i = 0; i < free_count_; ++i) free_[static_cast<std::size_t>(i)] = capacity() - 1 - i;  // slot n first
+  checkChains(in);
+}
+
+// Every segment's keyframes form one chain, linked both ways, from its oldest to its newest: what the loop closer
+// walks. A file that says otherwise is not one this code wrote.
+void PlaceMap::checkChains(const ByteReader& in) {
+  std::vector<int32_t>& visited = file_position_;
+  std::fill(visited.begin(), visited.end(), 0);
+  int reached = 0;
+  for (int slot = 0; slot < live_; ++slot) {
+    if (keyframes_[static_cast<std::size_t>(slot)].previous >= 0) continue;
+    for (int s = slot; s >= 0; s = keyframes_[static_cast<std::size_t>(s)].next) {
+      const PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(s)];
+      const bool linked = k.next < 0 || (keyframes_[static_cast<std::size_t>(k.next)].previous == s &&
+                                         keyframes_[static_cast<std::size_t>(k.next)].segment == k.segment);
+      const bool tail_is_newest = k.next >= 0 || newest_of_segment_[static_cast<std::size_t>(k.segment)] == s;
+      if (visited[static_cast<std::size_t>(s)]++ || !linked || !tail_is_newest)
+        in.fail("the keyframes of segment " + std::to_string(k.segment) + " are not one chain");
+      ++reached;
+    }
+  }
+  if (reached != live_) in.fail("keyframes in a cycle: the segments are not chains");
 }
 
 }  // namespace mcslam

@@ -2,6 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace mcslam {
 
 PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const PlacesOptions& options,
@@ -14,17 +17,43 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       relocalizer_(rig, options, odometry_options.scale_factor, max_features_per_camera),
       loop_closer_(rig, options, odometry_options.scale_factor, max_features_per_camera),
       seeds_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
-      landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1) {}
+      landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1),
+      file_words_(options.max_words_per_keyframe),
+      root_placed_(PlaceMap::kMaxSegments),
+      vocabulary_fingerprint_(vocabularyFingerprint(vocabulary)) {
+  for (int c = 0; c < rig.size(); ++c)
+    cameras_.push_back({static_cast<uint32_t>(rig.model(c).width()), static_cast<uint32_t>(rig.model(c).height())});
+  file_header_.cameras = cameras_;
+}
 
 void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry,
                                 PoseEstimate& out) {
   followSegment(odometry);
   // Before the keyframes settled in this frame join: they are in the new unit already.
   for (const Odometry::Rescale& r : odometry.rescales()) map_.rescaleSegment(segment_, r.s, r.center);
-  for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
-  if (out.state != TrackingState::Tracking && map_.size() > 0 && segment_ >= 0)
+  if (!localize_only_)
+    for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
+  if (out.state == TrackingState::Tracking && out.valid) {  // the odometry's path, for the drift it can have
+    if (have_last_position_) path_ += (out.T_w_b.t - last_position_).norm();
+    last_position_ = out.T_w_b.t;
+    have_last_position_ = true;
+  } else {
+    have_last_position_ = false;
+  }
+  if (out.state != TrackingState::Tracking && map_.size() > 0 && segment_ >= 0) {
     relocalize(frame, frame_index, odometry, out);
-  if (out.valid && segment_ >= 0) out.T_w_b = map_.segmentPose(segment_) * out.T_w_b;
+  } else if (out.state == TrackingState::Tracking && out.valid && segment_ >= 0 &&
+             (!map_.placed(segment_) || (localize_only_ && out.is_keyframe))) {
+    place(frame, frame_index, odometry, out.T_w_b);
+  }
+  if (out.valid && segment_ >= 0) {
+    if (map_.placed(segment_)) {
+      out.T_w_b = map_.segmentPose(segment_) * out.T_w_b;
+    } else {
+      out.valid = false;
+      out.state = TrackingState::Localizing;
+    }
+  }
   out.world_revision = world_revision_;
 }
 
@@ -35,7 +64,9 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
   if (odometry.stats().initializations == initializations_seen_) return;
   initializations_seen_ = odometry.stats().initializations;
   const SE3 T_w_o = segment_ >= 0 ? map_.segmentPose(segment_) : SE3();
-  const int32_t s = map_.createSegment(T_w_o);
+  // The first map of a run that reuses a saved one is nowhere in it until recognized.
+  const bool placed = segment_ >= 0 ? map_.placed(segment_) : !loaded_;
+  const int32_t s = map_.createSegment(T_w_o, placed);
   if (s < 0) {
     spdlog::warn("place memory: more than {} odometry maps; the newest keeps the last one's frame",
                  PlaceMap::kMaxSegments);
@@ -71,7 +102,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
       p.node = vocabulary_.ancestor(vocabulary_.word(l.descriptor), levels_up);
       p.cam = static_cast<int16_t>(c);
       p.octave = kf.features.sets[static_cast<std::size_t>(c)].keypoints[static_cast<std::size_t>(k)].octave;
-      p.landmark_id = l.id;
+      p.landmark_id = l.id + landmark_id_offset_;
       if (!map_.addPoint(slot, p)) break;
     }
   }
@@ -83,7 +114,10 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   // Sim(3), which is not built yet.
   if (options_.loop_closure && odometry.rigState().metric()) {
     loop_closer_.setRig(odometry.trackingRig());
-    if (loop_closer_.onKeyframe(slot, kf.features, words_, map_, database_)) ++world_revision_;
+    if (loop_closer_.onKeyframe(slot, kf.features, words_, map_, database_)) {
+      ++world_revision_;
+      propagatePlacement();
+    }
   }
 }
 
@@ -91,13 +125,33 @@ void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, O
   ++stats_.relocalization_queries;
   words_.compute(vocabulary_, frame);
   relocalizer_.setRig(odometry.trackingRig());
+  // Not on a keyframe of a map nowhere in the world (a run on a saved map, before it was recognized in it).
   const RelocalizationResult r =
-      relocalizer_.locate(frame, words_, map_, database_, map_.newestKeyframe(), [](int) { return false; });
+      relocalizer_.locate(frame, words_, map_, database_, map_.newestKeyframe(), [&](int slot) {
+        const int32_t s = map_.keyframe(slot).segment;
+        return s != segment_ && !map_.placed(s);
+      });
   if (!r.ok) return;
   spdlog::debug("place memory: frame {} at ({:.2f} {:.2f} {:.2f}) on keyframe {} of frame {} at ({:.2f} {:.2f} {:.2f})",
                 frame_index, r.T_w_b.t.x(), r.T_w_b.t.y(), r.T_w_b.t.z(), map_.keyframe(r.keyframe).id,
                 map_.keyframe(r.keyframe).frame_index, map_.keyframe(r.keyframe).T_w_k.t.x(),
                 map_.keyframe(r.keyframe).T_w_k.t.y(), map_.keyframe(r.keyframe).T_w_k.t.z());
+  // Lost before it was placed, and found in the saved map: the odometry continues in the world's frame.
+  if (!map_.placed(segment_) && map_.placed(map_.keyframe(r.keyframe).segment)) {
+    if (!enterWorld(frame_index)) return;
+  }
+  if (!resumeOdometry(frame, frame_index, odometry, r.T_w_b, out)) return;
+  ++stats_.relocalizations;
+  stats_.last_relocalized_keyframe = map_.keyframe(r.keyframe).id;
+  stats_.last_relocalized_frame = static_cast<int64_t>(frame_index);
+  spdlog::info("place memory: frame {} relocalized on place keyframe {} ({} inliers of {} candidates)", frame_index,
+               map_.keyframe(r.keyframe).id, r.inliers, r.candidates);
+  if (!localize_only_)
+    for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
+}
+
+bool PlaceMemory::resumeOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, const SE3& T_w_b,
+                                 PoseEstimate& out) {
   // Into the current segment's odometry frame: the odometry continues in it.
   const SE3 T_o_w = map_.segmentPose(segment_).inverse();
   int n = 0;
@@ -109,14 +163,170 @@ void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, O
     seed.descriptor = m.point->descriptor;
     seed.metric = true;
   }
-  odometry.relocalize(frame, frame_index, T_o_w * r.T_w_b, std::span(seeds_.data(), static_cast<std::size_t>(n)), out);
-  if (out.state != TrackingState::Tracking) return;
-  ++stats_.relocalizations;
-  stats_.last_relocalized_keyframe = map_.keyframe(r.keyframe).id;
-  stats_.last_relocalized_frame = static_cast<int64_t>(frame_index);
-  spdlog::info("place memory: frame {} relocalized on place keyframe {} ({} inliers of {} candidates)", frame_index,
-               map_.keyframe(r.keyframe).id, r.inliers, r.candidates);
-  for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
+  out.state = TrackingState::Lost;  // unless the odometry resumes
+  out.valid = false;
+  odometry.relocalize(frame, frame_index, T_o_w * T_w_b, std::span(seeds_.data(), static_cast<std::size_t>(n)), out);
+  return out.state == TrackingState::Tracking;
+}
+
+// The run, not yet placed, was recognized in the saved map: its odometry goes on in a new segment whose frame is
+// the world's, and what it mapped before (nowhere in the world, and of the same place) is dropped.
+bool PlaceMemory::enterWorld(uint64_t frame_index) {
+  const int32_t s = map_.createSegment(SE3(), /*placed=*/true);
+  if (s < 0) return false;
+  for (int slot = 0; slot < map_.capacity(); ++slot) {
+    if (!map_.keyframe(slot).alive || map_.keyframe(slot).segment != segment_) continue;
+    database_.erase(slot);
+    map_.eraseKeyframe(slot);
+  }
+  segment_ = s;
+  stats_.placed_frame = static_cast<int64_t>(frame_index);
+  return true;
+}
+
+void PlaceMemory::place(const FrameFeatures& frame, uint64_t frame_index, const Odometry& odometry, const SE3& T_o_b) {
+  words_.compute(vocabulary_, frame);
+  relocalizer_.setRig(odometry.trackingRig());
+  const int32_t own = segment_;
+  const RelocalizationResult r = relocalizer_.locate(frame, words_, map_, database_, last_place_keyframe_,
+                                                     [&](int slot) { return map_.keyframe(slot).segment == own; });
+  if (!r.ok || !map_.placed(map_.keyframe(r.keyframe).segment)) {
+    pending_fix_ = false;
+    return;
+  }
+  // Two recognitions in a row must agree on where the odometry's frame lies in the map.
+  const SE3 T_w_o = r.T_w_b * T_o_b.inverse();
+  const bool confirmed = pending_fix_ && sameCorrection(pending_T_w_o_, T_w_o, path_ - pending_path_);
+  pending_fix_ = !confirmed;
+  pending_T_w_o_ = T_w_o;
+  pending_path_ = path_;
+  if (!confirmed) return;
+  last_place_keyframe_ = r.keyframe;
+  if (!map_.placed(segment_)) {
+    map_.moveSegment(segment_, T_w_o);
+    map_.setPlaced(segment_);
+    stats_.placed_frame = static_cast<int64_t>(frame_index);
+    path_at_fix_ = path_;
+    spdlog::info("place memory: frame {} recognized in the map on keyframe {} ({} inliers): poses are in its frame",
+                 frame_index, map_.keyframe(r.keyframe).id, r.inliers);
+    return;
+  }
+  // Localizing: the odometry drifts from the map, and a recognition corrects it, when the correction is beyond the
+  // recognition's own uncertainty and within what the odometry can have drifted since the last one.
+  const SE3 correction = (map_.segmentPose(segment_) * T_o_b).inverse() * r.T_w_b;  // at the body
+  const double travelled = path_ - path_at_fix_;
+  const double angle_deg = so3Log(correction.R).norm() * 180.0 / M_PI;
+  if (withinUncertainty(correction, verifiedPoseSigma(r, options_))) return;
+  if (correction.t.norm() > options_.drift_floor_m + options_.drift_share * travelled ||
+      angle_deg > options_.drift_floor_deg + options_.drift_deg_per_m * travelled) {
+    spdlog::debug("place memory: frame {}: a recognition {:.2f} m, {:.1f} deg away after {:.1f} m: not a drift",
+                  frame_index, correction.t.norm(), angle_deg, travelled);
+    return;
+  }
+  spdlog::debug("place memory: frame {} on keyframe {} ({} inliers): localization corrected by {:.3f} m, {:.2f} deg",
+                frame_index, map_.keyframe(r.keyframe).id, r.inliers, correction.t.norm(), angle_deg);
+  map_.moveSegment(segment_, T_w_o);
+  path_at_fix_ = path_;
+  ++stats_.localization_corrections;
+  ++world_revision_;
+}
+
+void PlaceMemory::propagatePlacement() {
+  std::fill(root_placed_.begin(), root_placed_.end(), 0);
+  for (int32_t s = 0; s < map_.segments(); ++s)
+    if (map_.placed(s)) root_placed_[static_cast<std::size_t>(loop_closer_.root(s))] = 1;
+  for (int32_t s = 0; s < map_.segments(); ++s) {
+    if (map_.placed(s) || !root_placed_[static_cast<std::size_t>(loop_closer_.root(s))]) continue;
+    map_.setPlaced(s);
+    if (s == segment_) spdlog::info("place memory: a loop joined this run to the map: poses are in its frame");
+  }
+}
+
+std::size_t PlaceMemory::maxMapBytes() const {
+  return mapEnvelopeBytes() + mapHeaderBytes(static_cast<int>(cameras_.size())) + map_.maxWrittenBytes() +
+         static_cast<std::size_t>(map_.capacity()) *
+             (sizeof(uint32_t) + static_cast<std::size_t>(database_.maxWordsPerPlace()) * 2 * sizeof(uint32_t)) +
+         loop_closer_.maxWrittenBytes();
+}
+
+void PlaceMemory::writeMap(std::string& out) const {
+  MapFileHeader& h = file_header_;
+  h.cameras = cameras_;  // same size: no allocation
+  h.vocabulary_words = static_cast<uint32_t>(vocabulary_.wordCount());
+  h.vocabulary_fingerprint = vocabulary_fingerprint_;
+  h.keyframes = h.max_points_per_keyframe = 0;
+  h.points = 0;
+  for (int slot = 0; slot < map_.capacity(); ++slot) {
+    if (!map_.keyframe(slot).alive) continue;
+    ++h.keyframes;
+    const auto points = static_cast<uint32_t>(map_.keyframe(slot).point_count);
+    h.points += points;
+    h.max_points_per_keyframe = std::max(h.max_points_per_keyframe, points);
+  }
+  h.segments = static_cast<uint32_t>(map_.segments());
+  h.loops = static_cast<uint32_t>(loop_closer_.loops());
+  beginMapFile(out, h);
+  ByteWriter w(out);
+  map_.write(w);
+  for (int slot = 0; slot < map_.capacity(); ++slot) {  // the order PlaceMap::write keeps
+    if (!map_.keyframe(slot).alive) continue;
+    const std::span<const BowEntry> entries = database_.entries(slot);
+    w.put<uint32_t>(static_cast<uint32_t>(entries.size()));
+    for (const BowEntry& e : entries) {
+      w.put<int32_t>(e.word);
+      w.put<float>(e.weight);
+    }
+  }
+  loop_closer_.write(w, map_.segments());
+  finishMapFile(out);
+}
+
+void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool localize_only) {
+  ByteReader in({}, name);
+  const MapFileHeader h = openMapFile(bytes, name, in);
+  const auto describe = [](const std::vector<MapFileHeader::Camera>& cameras) {
+    std::string s = std::to_string(cameras.size()) + " cameras (";
+    for (std::size_t c = 0; c < cameras.size(); ++c)
+      s += (c ? ", " : "") + std::to_string(cameras[c].width) + "x" + std::to_string(cameras[c].height);
+    return s + ")";
+  };
+  const bool same_cameras =
+      h.cameras.size() == cameras_.size() &&
+      std::equal(cameras_.begin(), cameras_.end(), h.cameras.begin(),
+                 [](const auto& a, const auto& b) { return a.width == b.width && a.height == b.height; });
+  if (!same_cameras)
+    in.fail("the map was made by a rig of " + describe(h.cameras) + ", this one has " + describe(cameras_));
+  if (h.vocabulary_words != static_cast<uint32_t>(vocabulary_.wordCount()) ||
+      h.vocabulary_fingerprint != vocabulary_fingerprint_)
+    in.fail("the map was made with another vocabulary (fingerprint " + std::to_string(h.vocabulary_fingerprint) +
+            ", this one's " + std::to_string(vocabulary_fingerprint_) + "): its places cannot be recognized");
+  map_.read(in, static_cast<int>(cameras_.size()));
+  database_.clear();
+  int64_t last_landmark = -1;
+  for (int slot = 0; slot < map_.size(); ++slot) {
+    const auto count = in.take<uint32_t>("a keyframe's word count");
+    if (count > static_cast<uint32_t>(file_words_.capacity()))
+      in.fail("a keyframe of " + std::to_string(count) + " words, more than places.max_words_per_keyframe (" +
+              std::to_string(file_words_.capacity()) + ")");
+    file_words_.clear();
+    for (uint32_t i = 0; i < count; ++i) {
+      const auto word = in.take<WordId>("a word");
+      const auto weight = in.take<float>("a word's weight");
+      const bool in_order = file_words_.size() == 0 || file_words_.entries().back().word < word;
+      if (word < 0 || word >= vocabulary_.wordCount() || !in_order || !(weight >= 0) || !std::isfinite(weight))
+        in.fail("keyframe " + std::to_string(map_.keyframe(slot).id) + " has a word the vocabulary cannot give");
+      file_words_.push(word, weight);
+    }
+    database_.insert(slot, file_words_);
+    for (const PlacePoint& p : map_.points(slot)) last_landmark = std::max(last_landmark, p.landmark_id);
+  }
+  loop_closer_.read(in, map_.segments());
+  if (in.remaining() != 0) in.fail(std::to_string(in.remaining()) + " bytes of trailing data");
+  loaded_ = true;
+  localize_only_ = localize_only;
+  landmark_id_offset_ = last_landmark + 1;
+  segment_ = -1;
+  last_place_keyframe_ = -1;
 }
 
 }  // namespace mcslam

@@ -1,11 +1,33 @@
 #include "mcslam/places/relocalizer.hpp"
 
+#include <Eigen/LU>
+
+#include <algorithm>
 #include <climits>
 #include <cmath>
 
 #include <spdlog/spdlog.h>
 
 namespace mcslam {
+
+Vec6 verifiedPoseSigma(const RelocalizationResult& result, const PlacesOptions& options) {
+  Vec6 s;
+  const Eigen::FullPivLU<Mat6> lu(result.information);
+  const Vec6 variance = lu.isInvertible() ? Vec6(lu.inverse().diagonal()) : Vec6::Constant(1e6);
+  for (int k = 0; k < 6; ++k) s[k] = std::sqrt(std::max(variance[k], 0.0));
+  s.head<3>() = s.head<3>().cwiseMax(options.loop_sigma_translation);
+  s.tail<3>() = s.tail<3>().cwiseMax(options.loop_sigma_rotation_deg * M_PI / 180.0);
+  return s;
+}
+
+bool withinUncertainty(const SE3& correction, const Vec6& sigma) {
+  return correction.log().cwiseQuotient(sigma).squaredNorm() < 12.59;
+}
+
+bool sameCorrection(const SE3& a, const SE3& b, double distance) {
+  const SE3 difference = a.inverse() * b;
+  return difference.t.norm() < 0.05 * std::max(1.0, distance) && so3Log(difference.R).norm() < 2.0 * M_PI / 180.0;
+}
 
 namespace {
 

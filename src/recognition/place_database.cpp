@@ -11,7 +11,7 @@ PlaceDatabase::PlaceDatabase(int word_count, int max_places, int max_words_per_p
       blocks_(static_cast<std::size_t>(max_places) * static_cast<std::size_t>(max_words_per_place) / kBlockPostings +
               static_cast<std::size_t>(std::min<int64_t>(word_count, int64_t{max_places} * max_words_per_place)) + 1),
       free_blocks_(blocks_.size()),
-      words_of_(static_cast<std::size_t>(max_places) * static_cast<std::size_t>(max_words_per_place)),
+      entries_of_(static_cast<std::size_t>(max_places) * static_cast<std::size_t>(max_words_per_place)),
       word_count_of_(static_cast<std::size_t>(max_places), -1),
       selected_(static_cast<std::size_t>(max_words_per_place)),
       score_(static_cast<std::size_t>(max_places), 0.0f),
@@ -76,7 +76,7 @@ void PlaceDatabase::insert(int place, const BowVector& v) {
   const std::size_t base = static_cast<std::size_t>(place) * static_cast<std::size_t>(max_words_per_place_);
   for (std::size_t i = 0; i < entries.size(); ++i) {
     addPosting(entries[i].word, {place, entries[i].weight});
-    words_of_[base + i] = entries[i].word;
+    entries_of_[base + i] = entries[i];
   }
   word_count_of_[static_cast<std::size_t>(place)] = static_cast<int32_t>(entries.size());
   ++stored_;
@@ -86,9 +86,16 @@ void PlaceDatabase::erase(int place) {
   const int32_t count = word_count_of_[static_cast<std::size_t>(place)];
   if (count < 0) return;
   const std::size_t base = static_cast<std::size_t>(place) * static_cast<std::size_t>(max_words_per_place_);
-  for (int32_t i = 0; i < count; ++i) removePosting(words_of_[base + static_cast<std::size_t>(i)], place);
+  for (int32_t i = 0; i < count; ++i) removePosting(entries_of_[base + static_cast<std::size_t>(i)].word, place);
   word_count_of_[static_cast<std::size_t>(place)] = -1;
   --stored_;
+}
+
+std::span<const BowEntry> PlaceDatabase::entries(int place) const {
+  const int32_t count = word_count_of_[static_cast<std::size_t>(place)];
+  if (count < 0) return {};
+  return {entries_of_.data() + static_cast<std::size_t>(place) * static_cast<std::size_t>(max_words_per_place_),
+          static_cast<std::size_t>(count)};
 }
 
 void PlaceDatabase::clear() {

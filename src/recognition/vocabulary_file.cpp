@@ -3,14 +3,12 @@
 //   | u64 training images | u64 training descriptors
 //   | node presence, one byte per node | node descriptors, 32 bytes per node | idf, one f32 per word
 //   | u32 CRC-32 of everything before it
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <array>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 
+#include "mcslam/core/binary_io.hpp"
 #include "mcslam/core/checksum.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/synced_file.hpp"
@@ -32,49 +30,29 @@ std::size_t bodyBytes(const Vocabulary& v) {
          static_cast<std::size_t>(v.wordCount()) * sizeof(float);
 }
 
-template <class T>
-void put(std::string& out, T value) {
-  char bytes[sizeof(T)];
-  std::memcpy(bytes, &value, sizeof(T));
-  out.append(bytes, sizeof(T));
-}
-
-template <class T>
-T take(const std::string& in, std::size_t& at) {
-  T value;
-  std::memcpy(&value, in.data() + at, sizeof(T));
-  at += sizeof(T);
-  return value;
-}
-
-std::string readBounded(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) throw InputError(path + ": cannot open the vocabulary file");
-  if (!S_ISREG(st.st_mode)) throw InputError(path + ": not a regular file, so not a vocabulary file");
-  if (static_cast<std::size_t>(st.st_size) > kMaxFileBytes)
-    throw InputError(path + ": " + std::to_string(st.st_size) + " bytes, more than any vocabulary file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the vocabulary file");
-  std::string bytes(static_cast<std::size_t>(st.st_size), '\0');
-  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (static_cast<std::size_t>(in.gcount()) != bytes.size()) throw InputError(path + ": cannot read the whole file");
-  return bytes;
+// Presence, descriptors and idf: what a vocabulary is, apart from its shape and provenance.
+void writeBody(const Vocabulary& v, ByteWriter& out) {
+  for (int64_t n = 0; n < v.nodeCount(); ++n) out.put<uint8_t>(v.present(n) ? 1 : 0);
+  for (int64_t n = 0; n < v.nodeCount(); ++n) out.putBytes(v.descriptor(n).data(), sizeof(Descriptor));
+  for (WordId w = 0; w < v.wordCount(); ++w) out.put<float>(v.idf(w));
 }
 
 }  // namespace
 
 Vocabulary readVocabularyFile(const std::string& path) {
-  const std::string bytes = readBounded(path);
+  const std::string bytes = readFileBounded(path, kMaxFileBytes, "vocabulary file");
   if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
     throw InputError(path + ": not an mcslam vocabulary file (it does not start with 'MCSLVOC')");
-  std::size_t at = sizeof(kMagic);
-  const auto version = take<uint32_t>(bytes, at);
+  ByteReader in(bytes, path);
+  char magic[sizeof(kMagic)];
+  in.takeBytes(magic, sizeof(magic), "the magic");
+  const auto version = in.take<uint32_t>("the version");
   if (version != kVersion)
     throw InputError(path + ": vocabulary file version " + std::to_string(version) + ", this build reads version " +
                      std::to_string(kVersion));
-  const auto branching = take<uint32_t>(bytes, at);
-  const auto depth = take<uint32_t>(bytes, at);
-  const auto bits = take<uint32_t>(bytes, at);
+  const auto branching = in.take<uint32_t>("branching");
+  const auto depth = in.take<uint32_t>("depth");
+  const auto bits = in.take<uint32_t>("descriptor bits");
   if (bits != kDescriptorBits)
     throw InputError(path + ": descriptors of " + std::to_string(bits) + " bits, this build uses 256-bit ORB");
   if (branching > Vocabulary::kMaxBranching || depth > Vocabulary::kMaxDepth)
@@ -86,19 +64,20 @@ Vocabulary readVocabularyFile(const std::string& path) {
   } catch (const InputError& e) {
     throw InputError(path + ": " + e.what());
   }
-  v.training_images = take<uint64_t>(bytes, at);
-  v.training_descriptors = take<uint64_t>(bytes, at);
+  v.training_images = in.take<uint64_t>("training images");
+  v.training_descriptors = in.take<uint64_t>("training descriptors");
   const std::size_t expected = kHeaderBytes + bodyBytes(v) + sizeof(uint32_t);
   if (bytes.size() != expected)
     throw InputError(path + ": " + std::to_string(bytes.size()) + " bytes where a vocabulary of branching " +
                      std::to_string(branching) + " and depth " + std::to_string(depth) + " has " +
                      std::to_string(expected) + (bytes.size() < expected ? " (truncated)" : " (trailing data)"));
   const std::size_t crc_at = expected - sizeof(uint32_t);
-  std::size_t crc_pos = crc_at;
-  if (take<uint32_t>(bytes, crc_pos) != crc32(bytes.data(), crc_at))
+  uint32_t stored_crc = 0;
+  std::memcpy(&stored_crc, bytes.data() + crc_at, sizeof(stored_crc));
+  if (stored_crc != crc32(bytes.data(), crc_at))
     throw InputError(path + ": checksum mismatch: the vocabulary file is corrupt");
   const std::size_t nodes = static_cast<std::size_t>(v.nodeCount());
-  const std::size_t presence_at = at;
+  const std::size_t presence_at = in.offset();
   const std::size_t descriptors_at = presence_at + nodes;
   for (std::size_t n = 0; n < nodes; ++n) {
     if (bytes[presence_at + n] == 0) continue;
@@ -106,10 +85,18 @@ Vocabulary readVocabularyFile(const std::string& path) {
     std::memcpy(d.data(), bytes.data() + descriptors_at + n * sizeof(Descriptor), sizeof(Descriptor));
     v.setNode(static_cast<int64_t>(n), d);
   }
-  std::size_t idf_at = descriptors_at + nodes * sizeof(Descriptor);
-  for (WordId w = 0; w < v.wordCount(); ++w) v.setIdf(w, take<float>(bytes, idf_at));
+  ByteReader idf(std::string_view(bytes).substr(descriptors_at + nodes * sizeof(Descriptor)), path);
+  for (WordId w = 0; w < v.wordCount(); ++w) v.setIdf(w, idf.take<float>("idf"));
   if (v.empty()) throw InputError(path + ": the vocabulary has no words");
   return v;
+}
+
+uint32_t vocabularyFingerprint(const Vocabulary& v) {
+  std::string body;
+  body.reserve(bodyBytes(v));
+  ByteWriter out(body);
+  writeBody(v, out);
+  return crc32(body.data(), body.size());
 }
 
 std::vector<std::string> defaultVocabularyCandidates() {
@@ -137,24 +124,20 @@ Vocabulary loadVocabulary(const std::string& path) {
 }
 
 void writeVocabularyFile(const Vocabulary& v, const std::string& path) {
-  std::string out;
-  out.reserve(kHeaderBytes + bodyBytes(v) + sizeof(uint32_t));
-  out.append(kMagic, sizeof(kMagic));
-  put<uint32_t>(out, kVersion);
-  put<uint32_t>(out, static_cast<uint32_t>(v.branching()));
-  put<uint32_t>(out, static_cast<uint32_t>(v.depth()));
-  put<uint32_t>(out, kDescriptorBits);
-  put<uint64_t>(out, v.training_images);
-  put<uint64_t>(out, v.training_descriptors);
-  for (int64_t n = 0; n < v.nodeCount(); ++n) out.push_back(v.present(n) ? 1 : 0);
-  for (int64_t n = 0; n < v.nodeCount(); ++n) {
-    const Descriptor& d = v.descriptor(n);
-    out.append(reinterpret_cast<const char*>(d.data()), sizeof(Descriptor));
-  }
-  for (WordId w = 0; w < v.wordCount(); ++w) put<float>(out, v.idf(w));
-  put<uint32_t>(out, crc32(out.data(), out.size()));
+  std::string bytes;
+  bytes.reserve(kHeaderBytes + bodyBytes(v) + sizeof(uint32_t));
+  ByteWriter out(bytes);
+  out.putBytes(kMagic, sizeof(kMagic));
+  out.put<uint32_t>(kVersion);
+  out.put<uint32_t>(static_cast<uint32_t>(v.branching()));
+  out.put<uint32_t>(static_cast<uint32_t>(v.depth()));
+  out.put<uint32_t>(kDescriptorBits);
+  out.put<uint64_t>(v.training_images);
+  out.put<uint64_t>(v.training_descriptors);
+  writeBody(v, out);
+  out.put<uint32_t>(crc32(bytes.data(), bytes.size()));
   std::string error;
-  if (!writeFileSynced(path, out, &error)) throw InputError("cannot write the vocabulary: " + error);
+  if (!writeFileSynced(path, bytes, &error)) throw InputError("cannot write the vocabulary: " + error);
 }
 
 }  // namespace mcslam

@@ -81,5 +81,48 @@ TEST_F(Relocalization, ABlackoutIntoAnUnseenRoomFindsNothingAndStartsANewMap) {
   EXPECT_EQ(jsonInt(black.stats, "segments"), 2);
 }
 
+// Map reuse: the first 100 frames save their map; the rest, run by a new process, localize in it. From its first
+// frames the second run's poses are in the first run's frame: one alignment of both halves to the truth gives an
+// ATE no worse than the run in one go. Localizing leaves the map as it was.
+TEST_F(Relocalization, TheSecondHalfOfARunLocalizesInTheMapTheFirstHalfSaved) {
+  const Run plain = run("plain", "");
+  const std::string map = dir_->file("first.map");
+  const Run first = run("first", "--frames 100 --map-out " + map);
+  const Run second = run("second", "--start 100 --localize --map-in " + map);
+  EXPECT_GE(jsonInt(second.stats, "placed_frame"), 100);
+  EXPECT_LE(jsonInt(second.stats, "placed_frame"), 102) << second.stats;
+  EXPECT_EQ(jsonInt(second.stats, "place_keyframes"), jsonInt(first.stats, "place_keyframes"));
+  Trajectory both = first.trajectory;
+  both.insert(both.end(), second.trajectory.begin(), second.trajectory.end());
+  EXPECT_GE(second.trajectory.size(), 97u);  // all but the frames before it was recognized
+  const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+  const double ate = computeApe(gt, both, EvalOptions{}).stats.rmse;
+  EXPECT_LE(ate, plain.ate) << "one run " << plain.ate << ", halves " << first.ate << " and " << second.ate;
+}
+
+// Building on a saved map: the second run adds its keyframes to the loaded ones, in the loaded map's frame.
+TEST_F(Relocalization, ASecondRunBuildsOnTheSavedMap) {
+  const std::string map = dir_->file("build.map");
+  const Run first = run("build1", "--frames 100 --map-out " + map);
+  const Run second = run("build2", "--start 100 --map-in " + map);
+  EXPECT_GT(jsonInt(second.stats, "place_keyframes"), jsonInt(first.stats, "place_keyframes") + 10);
+  EXPECT_LE(jsonInt(second.stats, "placed_frame"), 102) << second.stats;
+  EXPECT_EQ(jsonInt(second.stats, "segments"), 2);
+}
+
+TEST_F(Relocalization, AnUnreadableMapEndsTheRunWithOneMessageNamingIt) {
+  const std::string map = dir_->file("broken.map");
+  test::writeFile(map, "MCSLMAP");
+  std::string out;
+  EXPECT_EQ(test::runCommand(
+                test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --map-in " + map, &out),
+            2);
+  EXPECT_NE(out.find("mcslam-run: " + map + ": not an mcslam map file"), std::string::npos) << out;
+  EXPECT_EQ(
+      test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --localize", &out),
+      2);
+  EXPECT_NE(out.find("--localize needs a map"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace mcslam

@@ -365,3 +365,111 @@ TEST(McslamdProcess, ShippedSimConfigChecksOutWithoutADataset) {
   for (const char* key : {"type: sim", "world: indoor", "cameras: [0, 1, 2, 3, 4]", "rig: 5 camera"})
     EXPECT_NE(out.find(key), std::string::npos) << key << " missing in:\n" << out;
 }
+
+namespace {
+
+// The frames [first, end) of an ASL dataset as a dataset of their own (same stamps, images linked): a robot that
+// restarts further along its route.
+std::string datasetTail(const std::string& data, const std::string& out, int first) {
+  namespace fs = std::filesystem;
+  fs::create_directories(out);
+  fs::copy_file(fs::path(data) / "camchain.yaml", fs::path(out) / "camchain.yaml");
+  for (int c = 0;; ++c) {
+    const fs::path cam = fs::path(data) / ("cam" + std::to_string(c));
+    if (!fs::exists(cam)) break;
+    fs::create_directories(fs::path(out) / cam.filename());
+    fs::create_directory_symlink(cam / "data", fs::path(out) / cam.filename() / "data");
+    std::ifstream in(cam / "data.csv");
+    std::ofstream csv(fs::path(out) / cam.filename() / "data.csv");
+    std::string line;
+    for (int row = -1; std::getline(in, line); ++row)
+      if (row < 0 || line[0] == '#' || row >= first) csv << line << "\n";
+  }
+  return out;
+}
+
+// The saves the last status line counts.
+uint64_t lastMapSaves(const std::string& log) {
+  const std::size_t at = log.rfind("map saves ");
+  return at == std::string::npos ? 0 : std::stoull(log.substr(at + 10));
+}
+
+std::string mapConfig(const std::string& data, const std::string& out, const std::string& map, const char* at_end,
+                      const std::string& extra = "") {
+  return "log_level: info\nstatus_interval_s: 0.2\nsource:\n  type: dataset\n  dataset:\n    path: " + data +
+         "\n    rate: fastest\n    at_end: " + at_end + "\npublish:\n  shm:\n    enabled: false\n" +
+         "output:\n  directory: " + out + "\nmap:\n  load: " + map + "\n  save: " + map + "\n  save_interval_s: 0.3\n" +
+         extra;
+}
+
+}  // namespace
+
+// systemd's restart after a crash: the daemon saves its map as it goes; SIGKILL ends it; started again (further
+// along the route, with the same configuration) it loads the map, recognizes where it is and publishes poses in
+// the same world frame as before the crash. Without the map the new run's frame would start at the robot's
+// pose there, 2.5 m away.
+TEST(McslamdProcess, AfterACrashTheRestartedDaemonKeepsTheWorldFrame) {
+  const std::string data = test::cachedSimDataset();
+  test::TempDir dir("mcslamd-restart");
+  const std::string map = dir.file("robot.mcmap");
+  std::filesystem::create_directories(dir.file("out1"));
+  std::filesystem::create_directories(dir.file("out2"));
+  const std::string first = test::writeFile(dir.file("first.yaml"), mapConfig(data, dir.file("out1"), map, "loop"));
+  const pid_t pid = spawnDaemon(first, dir.file("none.sock"), "0", dir.file("log1.txt"));
+  ASSERT_GT(pid, 0);
+  // A save made after the whole route was mapped once (the map file is replaced whole, never partly written).
+  ASSERT_TRUE(waitFor([&] { return readTumRows(dir.file("out1/trajectory.tum")).size() >= 60; }, 120))
+      << readAll(dir.file("log1.txt"));
+  const uint64_t saves = lastMapSaves(readAll(dir.file("log1.txt")));
+  ASSERT_TRUE(waitFor([&] { return lastMapSaves(readAll(dir.file("log1.txt"))) >= saves + 2; }, 60))
+      << readAll(dir.file("log1.txt"));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(std::filesystem::exists(map));
+  EXPECT_FALSE(std::filesystem::exists(map + ".tmp"));
+
+  const std::string tail = datasetTail(data, dir.file("tail"), 25);
+  const std::string second = test::writeFile(dir.file("second.yaml"), mapConfig(tail, dir.file("out2"), map, "exit"));
+  const pid_t again = spawnDaemon(second, dir.file("none.sock"), "0", dir.file("log2.txt"));
+  ASSERT_EQ(waitExit(again, 120), 0) << readAll(dir.file("log2.txt"));
+  const std::string log2 = readAll(dir.file("log2.txt"));
+  EXPECT_NE(log2.find("recognized in the map"), std::string::npos) << log2;
+
+  // Same stamps in both runs: the restarted run's poses against the first run's (its first pass over the route).
+  const Trajectory before = readTumTrajectory(dir.file("out1/trajectory.tum"));
+  const Trajectory after = readTumTrajectory(dir.file("out2/trajectory.tum"));
+  ASSERT_GE(after.size(), 20u) << log2;
+  // Every pose within decimetres of the first run's (two estimates of the same place), on average centimetres.
+  int compared = 0;
+  double sum = 0;
+  for (const auto& pose : after) {
+    for (const auto& reference : before) {
+      if (reference.t != pose.t) continue;
+      const double d = (reference.T_w_b.t - pose.T_w_b.t).norm();
+      EXPECT_LT(d, 0.3) << "t = " << toSeconds(pose.t);
+      sum += d;
+      ++compared;
+      break;
+    }
+  }
+  ASSERT_GE(compared, 20);
+  EXPECT_LT(sum / compared, 0.05);
+}
+
+// A map file that cannot be read ends start-up with one message naming it, unless the configuration says to start
+// without it; then the file is set aside (not overwritten by the next save) and the daemon maps anew.
+TEST(McslamdProcess, AnUnreadableMapStopsStartUpOrIsSetAsideWhenConfigured) {
+  test::TempDir dir("mcslamd-badmap");
+  const std::string data = test::writeSmallDataset(dir.file("data"), 2, 5);
+  const std::string map = test::writeFile(dir.file("robot.mcmap"), "MCSLMAP\1 not a map");
+  const std::string strict = test::writeFile(dir.file("strict.yaml"), mapConfig(data, dir.file("."), map, "exit"));
+  std::string out;
+  EXPECT_EQ(test::runCommand(test::binPath("mcslamd") + " --config " + strict, &out), 2);
+  EXPECT_NE(out.find(map + ": not an mcslam map file"), std::string::npos) << out;
+  const std::string lenient = test::writeFile(
+      dir.file("lenient.yaml"), mapConfig(data, dir.file("."), map, "exit", "  on_unreadable: start_empty\n"));
+  EXPECT_EQ(test::runCommand(test::binPath("mcslamd") + " --config " + lenient, &out), 0) << out;
+  EXPECT_NE(out.find("starting without a map"), std::string::npos) << out;
+  EXPECT_EQ(test::readFile(map + ".unreadable"), "MCSLMAP\1 not a map");
+}

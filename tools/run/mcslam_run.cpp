@@ -12,6 +12,7 @@
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/core/synced_file.hpp"
 #include "mcslam/dataset/dataset.hpp"
 #include "mcslam/pipeline/dataset_frame.hpp"
 #include "mcslam/pipeline/slam_pipeline.hpp"
@@ -30,6 +31,9 @@ struct RunOptions {
   std::size_t max_frames = 0;
   std::string black_text, skip_text;  // fault injection: frame ranges "A-B"
   bool no_loop_closure = false;
+  std::size_t first_frame = 0;
+  std::string map_in, map_out;
+  bool localize = false;
 };
 
 // A range of frames "A-B" (both included) or "A"; empty text: none. Throws InputError naming the option.
@@ -70,6 +74,12 @@ void addOptions(CLI::App& app, RunOptions& o) {
   app.add_option("--stats", o.stats_path, "Timing per stage (mean, p99) and tracking states, JSON");
   app.add_option("--extrinsics", o.extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", o.max_frames, "Process only the first N rig frames (0: all)");
+  app.add_option("--start", o.first_frame, "Begin at rig frame N of the dataset (with --frames: N of them)");
+  app.add_option("--map-in", o.map_in,
+                 "Reuse this saved map: poses are in its frame from the first frame recognized in it (before that "
+                 "the state is 'localizing' and no pose is written)");
+  app.add_option("--map-out", o.map_out, "Save the place map at the end (written whole or not at all)");
+  app.add_flag("--localize", o.localize, "With --map-in: localize in the map without changing it");
   app.add_flag("--quiet", o.quiet, "No progress bar");
   app.add_flag("--no-loop-closure", o.no_loop_closure,
                "Relocalize, but close no loop (places.loop_closure: false), for comparisons");
@@ -256,6 +266,12 @@ void printSummary(const SlamPipeline& pipeline, const run::RunReport& report, do
   }
 }
 
+void saveMap(const SlamPipeline& pipeline, const std::string& path) {
+  std::string bytes, error;
+  if (!pipeline.writeMap(bytes)) throw InputError("--map-out: there is no map to save: places.enabled is false");
+  if (!writeFileSynced(path, bytes, &error)) throw InputError("--map-out: " + error);
+}
+
 int runDataset(const RunOptions& o) {
   DatasetOptions dopt;
   if (!o.cameras_text.empty()) dopt.cameras = parseCameraList(o.cameras_text);
@@ -266,20 +282,28 @@ int runDataset(const RunOptions& o) {
   PipelineConfig config =
       parsePipelineConfig(slamSection(o.config_path), o.config_path.empty() ? "defaults" : o.config_path, ds.rig());
   if (o.no_loop_closure) config.places.loop_closure = false;
+  if (o.localize && o.map_in.empty()) throw InputError("--localize needs a map to localize in (--map-in)");
+  if (o.localize && !o.map_out.empty())
+    throw InputError("--map-out with --localize: a map only localized in is not changed, there is nothing to save");
   if (o.print_config) {
     std::fputs(formatPipelineConfig(config).c_str(), stdout);
     return 0;
   }
   SlamPipeline pipeline(ds.rig(), config);
-  const std::size_t frames = o.max_frames > 0 ? std::min(o.max_frames, ds.size()) : ds.size();
+  if (!o.map_in.empty()) pipeline.loadMap(o.map_in, o.localize);
+  if (o.first_frame >= ds.size())
+    throw InputError("--start " + std::to_string(o.first_frame) + ": the dataset has " + std::to_string(ds.size()) +
+                     " frames");
+  const std::size_t available = ds.size() - o.first_frame;
+  const std::size_t frames = o.first_frame + (o.max_frames > 0 ? std::min(o.max_frames, available) : available);
   const FrameRange black = parseFrameRange("--black", o.black_text);
   const FrameRange skip = parseFrameRange("--skip", o.skip_text);
   std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < frames; ++i)
+  for (std::size_t i = o.first_frame; i < frames; ++i)
     if (!skip.contains(i)) order.push_back(i);
   if (!o.quiet) {
     std::fprintf(stderr, "mcslam-run: %s (%s), %d camera%s, %zu frames\n", o.dataset_dir.c_str(), ds.format().c_str(),
-                 ds.rig().size(), ds.rig().size() == 1 ? "" : "s", frames);
+                 ds.rig().size(), ds.rig().size() == 1 ? "" : "s", order.size());
   }
   run::RunReport report;
   Console console(o.quiet, order.size());
@@ -288,6 +312,7 @@ int runDataset(const RunOptions& o) {
   if (!o.keyframes_path.empty()) writeTumTrajectory(o.keyframes_path, report.keyframes());
   if (!o.stats_path.empty()) report.writeStats(o.stats_path, pipeline, o.dataset_dir, ds.rig().size(), wall);
   if (!o.extrinsics_path.empty()) writeKalibrRig(pipeline.refinedRig(), o.extrinsics_path);
+  if (!o.map_out.empty()) saveMap(pipeline, o.map_out);
   if (!o.quiet) printSummary(pipeline, report, wall);
   return 0;
 }

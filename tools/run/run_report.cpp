@@ -82,7 +82,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw InputError(path + ": cannot write stats file");
   std::vector<double> features, tracking, optimization, total;
-  uint64_t state_count[3] = {0, 0, 0};
+  uint64_t state_count[4] = {0, 0, 0, 0};
   int interpolated = 0, unknown_scale = 0;
   for (const FrameRecord& r : frames_) {
     features.push_back(r.timing.features_ms);
@@ -106,6 +106,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("tracking").value(state_count[static_cast<int>(TrackingState::Tracking)]);
   j.key("not_initialized").value(state_count[static_cast<int>(TrackingState::NotInitialized)]);
   j.key("lost").value(state_count[static_cast<int>(TrackingState::Lost)]);
+  j.key("localizing").value(state_count[static_cast<int>(TrackingState::Localizing)]);
   j.endObject();
   // Where tracking was lost and regained: every change of state, with its frame index and time.
   j.key("state_changes").beginArray();
@@ -151,6 +152,10 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("loop_closures").value(l.closures);
     j.key("map_merges").value(l.merges);
     j.key("world_revision").value(static_cast<unsigned long long>(places->worldRevision()));
+    j.key("map_loaded").value(places->mapLoaded());
+    j.key("placed_frame").value(static_cast<long long>(p.placed_frame));  // first frame recognized in the loaded map
+    j.key("localization_corrections").value(p.localization_corrections);
+    j.key("place_keyframes").value(static_cast<long long>(places->map().size()));  // in the map now, loaded included
     j.endObject();
   }
   j.key("timing_ms").beginObject();

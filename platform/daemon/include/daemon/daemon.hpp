@@ -17,6 +17,7 @@
 #include "daemon/assembly_stage.hpp"
 #include "daemon/daemon_config.hpp"
 #include "daemon/frames.hpp"
+#include "daemon/map_saver.hpp"
 #include "daemon/processing_stage.hpp"
 #include "daemon/publishing_stage.hpp"
 #include "daemon/trigger_stage.hpp"
@@ -40,6 +41,9 @@ struct DaemonStats {
   bool warm = false;
   uint64_t frames_after_warmup = 0, allocations_after_warmup = 0;  // our threads
   bool source_finished = false;
+  // Place memory: what the status reports of it, and the map file's saves.
+  PlaceCounters places;
+  uint64_t map_saves = 0, map_save_failures = 0;
 };
 
 class Daemon {
@@ -71,11 +75,15 @@ class Daemon {
 
  private:
   void writeRefinedExtrinsics();
+  // map.load into the processor (a missing file: a first start; an unreadable one: InputError, or set aside with
+  // map.on_unreadable start_empty), and the saver of map.save.
+  static std::unique_ptr<MapSaver> prepareMap(const DaemonConfig& config, FrameProcessor& processor);
 
   DaemonConfig config_;
   std::unique_ptr<FrameProcessor> processor_;
   std::unique_ptr<FrameSource> source_;
   std::vector<std::pair<int, int>> sizes_;
+  std::unique_ptr<MapSaver> map_saver_;  // before the stages: a map that cannot be loaded ends start-up first
 
   // The rings and signals between the stages; the stages hold references to them.
   CameraRings camera_rings_;

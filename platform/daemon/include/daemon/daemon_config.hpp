@@ -43,6 +43,15 @@ struct OutputConfig {
   std::string extrinsics = "extrinsics.yaml";
 };
 
+// The place map kept across restarts (docs/daemon.md, "map"). Paths are relative to the output directory.
+struct MapConfig {
+  std::string load;                       // empty: start without one; a missing file: start a new one there
+  std::string save;                       // empty: never saved
+  double save_interval_s = 60;            // 0: only at a clean stop
+  bool localize_only = false;             // mode localize: the loaded map is used, never changed (nor saved)
+  bool start_without_unreadable = false;  // on_unreadable start_empty: set an unreadable map aside, start without
+};
+
 struct RealtimeConfig {
   int trigger_priority = 0;  // SCHED_FIFO 1..99, 0 = normal scheduling
   int acquisition_priority = 0;
@@ -65,6 +74,7 @@ struct DaemonConfig {
   CapacityConfig capacities;
   PublishConfig publish;
   OutputConfig output;
+  MapConfig map;
   RealtimeConfig realtime;
   YAML::Node slam;  // handed to the pipeline factory
   Rig rig;          // resolved: calibration file, the dataset's own, or the simulated rig's cameras

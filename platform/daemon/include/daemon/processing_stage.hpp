@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "daemon/frames.hpp"
+#include "daemon/map_saver.hpp"
 #include "mcslam/pipeline/stage_runner.hpp"
 #include "realtime/alloc_meter.hpp"
 #include "realtime/warm_up.hpp"
@@ -18,8 +19,9 @@ namespace mcslam::platform {
 
 class ProcessingStage {
  public:
+  // `map_saver` (may be null) saves the processor's map between frames.
   ProcessingStage(FrameProcessor& processor, int cameras, int priority, uint64_t warmup_frames, RigRing& in,
-                  PoseRing& out, BackPressure& pressure, WarmUp& warm_up);
+                  PoseRing& out, BackPressure& pressure, WarmUp& warm_up, MapSaver* map_saver = nullptr);
   void start();
   // Asks the threads to end once the rig ring is empty and every prepared frame is finished.
   void requestStop();
@@ -34,6 +36,8 @@ class ProcessingStage {
   TrackingState tracking() const { return static_cast<TrackingState>(tracking_.load(std::memory_order_relaxed)); }
   bool unscaled() const { return unscaled_.load(std::memory_order_relaxed); }
   uint64_t allocationsSinceWarmup() const { return features_meter_.since() + processing_meter_.since(); }
+  // As of the last frame processed (zeros for a processor without place memory).
+  PlaceCounters placeCounters() const;
 
  private:
   // What the daemon needs to know again about a frame once it is processed.
@@ -48,6 +52,10 @@ class ProcessingStage {
   RigFrameView viewOf(const RigFrame& f);
   void handOver(PoseSlot& out, const FrameTag& tag);
 
+  void afterFrame();  // place counters, map saving
+
+  FrameProcessor& processor_;
+  MapSaver* map_saver_;
   StageRunner<FrameTag> runner_;
   int priority_;
   uint64_t warmup_frames_;
@@ -61,6 +69,9 @@ class ProcessingStage {
   std::atomic<uint64_t> processed_{0}, pose_drops_{0};
   std::atomic<uint8_t> tracking_{0};
   std::atomic<bool> unscaled_{false};
+  std::atomic<uint64_t> relocalizations_{0}, loop_closures_{0}, map_merges_{0}, localization_corrections_{0};
+  std::atomic<int64_t> place_keyframes_{0};
+  std::atomic<uint16_t> world_revision_{0};
   ThreadAllocMeter features_meter_, processing_meter_;
 };
 

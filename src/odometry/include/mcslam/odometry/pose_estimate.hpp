@@ -12,6 +12,7 @@ enum class TrackingState : uint8_t {
   NotInitialized = 0,  // no map yet (waiting for enough features or parallax)
   Tracking = 1,        // pose estimated against the map
   Lost = 2,            // tracking failed on this frame; the pipeline re-initializes and goes on
+  Localizing = 3,      // tracking, but not yet recognized in the saved map the run reuses: no pose in its world
 };
 
 inline const char* trackingStateName(TrackingState s) {
@@ -19,6 +20,7 @@ inline const char* trackingStateName(TrackingState s) {
     case TrackingState::NotInitialized: return "not_initialized";
     case TrackingState::Tracking: return "tracking";
     case TrackingState::Lost: return "lost";
+    case TrackingState::Localizing: return "localizing";
   }
   return "?";
 }

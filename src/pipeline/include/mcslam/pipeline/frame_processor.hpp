@@ -3,8 +3,10 @@
 // a rig frame of grey images goes in, a pose estimate comes out. Implementations allocate all
 // their memory at construction; process() does not touch the heap after warm-up.
 #include <cstdint>
+#include <string>
 
 #include "mcslam/calib/rig.hpp"
+#include "mcslam/core/error.hpp"
 #include "mcslam/core/image.hpp"
 #include "mcslam/core/se3.hpp"
 #include "mcslam/core/time.hpp"
@@ -19,6 +21,16 @@ struct RigFrameView {
   int cameras = 0;
   const ImageView* images = nullptr;
   const bool* present = nullptr;
+};
+
+// What place memory has done so far, for a daemon's status.
+struct PlaceCounters {
+  uint64_t relocalizations = 0;
+  uint64_t loop_closures = 0;
+  uint64_t map_merges = 0;
+  uint64_t localization_corrections = 0;
+  int64_t keyframes = 0;  // in the place map, a loaded map's included
+  uint16_t world_revision = 0;
 };
 
 class FrameProcessor {
@@ -48,6 +60,26 @@ class FrameProcessor {
     (void)out;
     return false;
   }
+
+  // Place memory. loadMap() (before the first frame) reuses a saved map, only localizing in it when
+  // `localize_only`; InputError naming the file when it cannot, or when the processor keeps no map. writeMap()
+  // writes the map file's bytes into `out`, allocating nothing when `out` holds maxMapBytes() (false: no map).
+  // These and placeCounters() are called between frames, on the thread that finishes them.
+  virtual void loadMap(const std::string& path, bool localize_only);
+  virtual bool writeMap(std::string& out) const {
+    (void)out;
+    return false;
+  }
+  virtual std::size_t maxMapBytes() const { return 0; }
+  virtual bool placeCounters(PlaceCounters& out) const {
+    (void)out;
+    return false;
+  }
 };
+
+inline void FrameProcessor::loadMap(const std::string& path, bool localize_only) {
+  (void)localize_only;
+  throw InputError(path + ": this frame processor keeps no map");
+}
 
 }  // namespace mcslam

@@ -42,6 +42,11 @@ class SlamPipeline final : public FrameProcessor {
   const OdometryStats& stats() const { return odometry_.stats(); }
   // Place memory; nullptr when the configuration turns it off.
   const PlaceMemory* places() const { return places_.get(); }
+  // The map file (FrameProcessor): InputError also when place memory is off.
+  void loadMap(const std::string& path, bool localize_only) override;
+  bool writeMap(std::string& out) const override;
+  std::size_t maxMapBytes() const override { return places_ ? places_->maxMapBytes() : 0; }
+  bool placeCounters(PlaceCounters& out) const override;
   uint64_t rejectedImages() const { return front_end_.rejectedImages(); }
   int cameras() const { return rig_.size(); }
   bool initialized() const { return odometry_.initialized(); }

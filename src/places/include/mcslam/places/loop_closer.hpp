@@ -37,7 +37,16 @@ class LoopCloser {
   bool onKeyframe(int slot, const FrameFeatures& features, const FrameWords& words, PlaceMap& map,
                   const PlaceDatabase& database);
   const LoopStats& stats() const { return stats_; }
+  int loops() const { return loop_count_; }
   void clear();
+  // The segment that stands for all those loops have joined to `segment`.
+  int32_t root(int32_t segment) { return findRoot(segment); }
+
+  // The map file's part: the loops and which segments they joined. read() replaces them (InputError from `in` for
+  // a file that does not fit max_loops or the map's `segments`).
+  void write(ByteWriter& out, int segments) const;
+  void read(ByteReader& in, int segments);
+  std::size_t maxWrittenBytes() const;
 
  private:
   struct LoopEdge {
@@ -52,6 +61,7 @@ class LoopCloser {
   void buildGraph(const PlaceMap& map);
   int segmentEnd(const PlaceMap& map, int32_t segment, bool oldest) const;  // slot, -1 when the segment is empty
   int slotOfId(const PlaceMap& map, int64_t id) const;
+  int32_t findRoot(int32_t segment);
 
   PlacesOptions options_;
   Relocalizer verifier_;

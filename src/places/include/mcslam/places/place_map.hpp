@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "mcslam/core/binary_io.hpp"
 #include "mcslam/core/se3.hpp"
 #include "mcslam/core/time.hpp"
 #include "mcslam/features/keypoint.hpp"
@@ -42,7 +43,8 @@ struct PlaceKeyframe {
 
 class PlaceMap {
  public:
-  static constexpr int kMaxSegments = 256;
+  // Each odometry map of each run is a segment (a map reused over many runs gains one per run).
+  static constexpr int kMaxSegments = 1024;
 
   PlaceMap(int max_keyframes, int max_points_per_keyframe);
 
@@ -71,12 +73,26 @@ class PlaceMap {
   std::span<const PlacePoint> pointsOfNode(int slot, int32_t node) const;
   int newestKeyframe() const { return newest_; }  // slot, -1 when empty
 
-  // Segments: T_w_o of each, and whether it is known in the world (the first segment is; one started after a loss
-  // that relocalization could not bridge is not, until a recognition joins it).
-  int32_t createSegment(const SE3& T_w_o);  // -1 when there are kMaxSegments
+  // Segments: T_w_o of each, and whether it is placed in the world. A run's first map defines the world and one
+  // started after a loss continues the frame the odometry coasted in: both are placed. The first map of a run
+  // that reuses a saved map is not, until the rig is recognized in the saved map (moveSegment) or a loop joins it.
+  int32_t createSegment(const SE3& T_w_o, bool placed = true);  // -1 when there are kMaxSegments
   int segments() const { return segment_count_; }
   const SE3& segmentPose(int32_t segment) const { return segment_T_w_o_[static_cast<std::size_t>(segment)]; }
   void setSegmentPose(int32_t segment, const SE3& T_w_o) { segment_T_w_o_[static_cast<std::size_t>(segment)] = T_w_o; }
+  bool placed(int32_t segment) const { return segment_placed_[static_cast<std::size_t>(segment)] != 0; }
+  void setPlaced(int32_t segment) { segment_placed_[static_cast<std::size_t>(segment)] = 1; }
+  // The segment, as one rigid piece, now has T_w_o: its keyframes follow (a segment no loop has bent yet).
+  void moveSegment(int32_t segment, const SE3& T_w_o);
+
+  // The map file's part of the place map: segments and live keyframes with their points, in slot order. read()
+  // replaces the map by the file's, its keyframes in slots 0.. in that order; a file that does not fit the capacities,
+  // or whose points name a camera beyond `cameras`, is refused (InputError from `in`).
+  void write(ByteWriter& out) const;
+  void read(ByteReader& in, int cameras);
+  // Bytes write() needs at most for this map's capacities.
+  std::size_t maxWrittenBytes() const;
+  int64_t nextId() const { return next_id_; }
 
  private:
   std::vector<PlaceKeyframe> keyframes_;
@@ -89,6 +105,10 @@ class PlaceMap {
   int64_t next_id_ = 0;
   std::vector<int32_t> newest_of_segment_;
   std::vector<SE3> segment_T_w_o_;
+  std::vector<uint8_t> segment_placed_;
+  mutable std::vector<int32_t> file_position_;  // scratch of write() and read(), one per slot
+
+  void checkChains(const ByteReader& in);
   int segment_count_ = 0;
 };
 

@@ -3,13 +3,18 @@
 // processed a frame, PlaceMemory adds the keyframes it settled to the place map (with their points and their words
 // in the database), relocalizes the frame when the odometry lost it (all cameras query the database; generalized
 // P3P verifies), and puts the estimate into the world frame: T_w_b = T_w_o(segment) * T_o_b (docs/design/places.md).
+// A run that reuses a saved map (readMap) is placed in the map's world when the rig is first recognized in it;
+// until then its poses are not published as valid (TrackingState::Localizing).
 // Fixed memory: everything is sized at construction; processing a frame allocates nothing.
 #include <cstdint>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/odometry/odometry.hpp"
 #include "mcslam/places/loop_closer.hpp"
+#include "mcslam/places/map_file.hpp"
 #include "mcslam/places/place_map.hpp"
 #include "mcslam/places/places_options.hpp"
 #include "mcslam/places/relocalizer.hpp"
@@ -26,6 +31,8 @@ struct PlaceStats {
   uint64_t relocalizations = 0;            // ... and were found
   int64_t last_relocalized_keyframe = -1;  // id of the place keyframe the last relocalization verified on
   int64_t last_relocalized_frame = -1;     // frame index of the last relocalization
+  int64_t placed_frame = -1;               // with a reused map: the frame first recognized in it
+  uint64_t localization_corrections = 0;   // localizing in a map: recognitions that moved the estimate
 };
 
 class PlaceMemory {
@@ -45,10 +52,29 @@ class PlaceMemory {
   // Times the world estimate moved (loop closures, merges); PoseEstimate::world_revision carries it.
   uint16_t worldRevision() const { return world_revision_; }
 
+  // The map file (map_file.hpp) of the place map, in `out`; allocates nothing when `out` has maxMapBytes()
+  // reserved.
+  void writeMap(std::string& out) const;
+  std::size_t maxMapBytes() const;
+  // Replaces the place map by the file's (`bytes` of the file `name`), before the first frame; with
+  // `localize_only` the run only localizes in it and never changes it. InputError naming the file for one that is
+  // not a map, was made for another rig or vocabulary, or exceeds the capacities.
+  void readMap(std::string_view bytes, const std::string& name, bool localize_only = false);
+  bool mapLoaded() const { return loaded_; }
+
  private:
   void followSegment(const Odometry& odometry);
   void addKeyframe(const Odometry& odometry, int odometry_slot);
   void relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);
+  // The tracked frame recognized in the map's other segments places the run in the world, or (localizing in a
+  // map) corrects the current segment's T_w_o.
+  void place(const FrameFeatures& frame, uint64_t frame_index, const Odometry& odometry, const SE3& T_o_b);
+  bool enterWorld(uint64_t frame_index);
+  // The odometry goes on at T_w_b from the relocalizer's last inliers, in the current segment's frame; false (and
+  // `out` lost) when it could not.
+  bool resumeOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, const SE3& T_w_b,
+                      PoseEstimate& out);
+  void propagatePlacement();  // after a loop: segments joined to a placed one are placed
 
   const Vocabulary& vocabulary_;
   PlacesOptions options_;
@@ -62,6 +88,22 @@ class PlaceMemory {
   int32_t segment_ = -1;
   uint64_t initializations_seen_ = 0;
   uint16_t world_revision_ = 0;
+  bool loaded_ = false;
+  bool localize_only_ = false;
+  int64_t landmark_id_offset_ = 0;  // past the loaded map's: this run's landmark ids continue after them
+  int last_place_keyframe_ = -1;    // slot of the keyframe the last placement verified on
+  // Placement: the last recognition's T_w_o, waiting for the next one to confirm it; the odometry's path so far.
+  bool pending_fix_ = false;
+  SE3 pending_T_w_o_;
+  double pending_path_ = 0;
+  double path_ = 0, path_at_fix_ = 0;
+  Vec3 last_position_ = Vec3::Zero();
+  bool have_last_position_ = false;
+  BowVector file_words_;              // scratch of readMap()
+  std::vector<uint8_t> root_placed_;  // scratch of propagatePlacement(), per segment
+  std::vector<MapFileHeader::Camera> cameras_;
+  mutable MapFileHeader file_header_;  // scratch of writeMap(), its cameras sized at construction
+  uint32_t vocabulary_fingerprint_ = 0;
   PlaceStats stats_;
 };
 

@@ -41,6 +41,14 @@ struct PlacesOptions {
   double loop_sigma_translation = 0.02;
   double loop_sigma_rotation_deg = 0.5;
 
+  // Localizing in a saved map (PlaceMemory::readMap), a recognition corrects the odometry only by what it can have
+  // drifted since the last correction: this floor plus this share of the path (and likewise in angle). Visual odometry
+  // drifts about 1%; a recognition beyond several times that is repeated texture.
+  double drift_floor_m = 0.2;
+  double drift_share = 0.05;
+  double drift_floor_deg = 1.0;
+  double drift_deg_per_m = 0.1;
+
   // Relocalization: how long the odometry stays lost, trying to relocalize, before it starts a new map.
   double relocalization_timeout_s = 3.0;
 };

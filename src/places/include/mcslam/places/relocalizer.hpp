@@ -41,6 +41,19 @@ struct RelocalizationResult {
   Mat6 information = Mat6::Zero();  // of T_w_b given the candidate's points ([rho; phi], right perturbation)
 };
 
+// Standard deviations of a verified pose ([rho; phi]) from the refinement's information, which takes the map's
+// points as exact: not below the floors of `options` (the points' own errors). Points far away leave the
+// translation along the view loosely known, and the result says so.
+Vec6 verifiedPoseSigma(const RelocalizationResult& result, const PlacesOptions& options);
+
+// A correction that lies within its measurement's uncertainty (chi-square, 6 dof, 95%): applying it would only add
+// the measurement's noise to every published pose.
+bool withinUncertainty(const SE3& correction, const Vec6& sigma);
+
+// Two corrections of the world found by consecutive recognitions, `distance` metres apart, agree: repeated
+// texture may fool one recognition, rarely two in a row the same way.
+bool sameCorrection(const SE3& a, const SE3& b, double distance);
+
 class Relocalizer {
  public:
   Relocalizer(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera);

@@ -37,6 +37,9 @@ class PlaceDatabase {
   void insert(int place, const BowVector& v);
   void erase(int place);
   void clear();
+  // What place `place` keeps (its heaviest words, in word order; empty when the slot is): inserting it again
+  // stores the same place.
+  std::span<const BowEntry> entries(int place) const;
 
   // Writes into `out` the places with score >= min_score for which accept(place) is true, best first, at most
   // out.size() of them; returns how many.
@@ -86,7 +89,7 @@ class PlaceDatabase {
   std::vector<Block> blocks_;         // the pool
   std::vector<int32_t> free_blocks_;  // a stack of unused block indices
   int free_block_count_ = 0;
-  std::vector<WordId> words_of_;        // place p's words: [p * max_words_per_place_, +word_count_of_[p])
+  std::vector<BowEntry> entries_of_;    // place p's words: [p * max_words_per_place_, +word_count_of_[p])
   std::vector<int32_t> word_count_of_;  // per place: words stored, -1 when the slot is empty
   std::vector<BowEntry> selected_;      // scratch of insert()
   mutable std::vector<float> score_;

@@ -72,4 +72,8 @@ Vocabulary loadVocabulary(const std::string& path);
 // Written whole or not at all (writeFileSynced). Throws InputError naming the file when it cannot.
 void writeVocabularyFile(const Vocabulary& vocabulary, const std::string& path);
 
+// CRC-32 of the words (nodes and idf): a map file keeps it, so that it is only used with the vocabulary it was made
+// with.
+uint32_t vocabularyFingerprint(const Vocabulary& vocabulary);
+
 }  // namespace mcslam
