@@ -7,11 +7,11 @@
 #include <memory>
 
 #include "alloc_testing.hpp"
+#include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/places/map_file.hpp"
 #include "mcslam/places/place_map.hpp"
 #include "mcslam/places/place_memory.hpp"
-#include "mcslam/calib/calibration_io.hpp"
 #include "test_support.hpp"
 
 namespace mcslam {
@@ -80,7 +80,8 @@ TEST(MapFile, ThePlaceMapSurvivesAWriteAndARead) {
     EXPECT_TRUE(r.T_w_k.R.isApprox(k.T_w_k.R) && r.T_w_k.t.isApprox(k.T_w_k.t));
     EXPECT_TRUE(r.T_o_k.t.isApprox(k.T_o_k.t));
     // Neighbours are the same keyframes (by id), in other slots.
-    EXPECT_EQ(r.previous < 0 ? -1 : after.keyframe(r.previous).id, k.previous < 0 ? -1 : before.keyframe(k.previous).id);
+    EXPECT_EQ(r.previous < 0 ? -1 : after.keyframe(r.previous).id,
+              k.previous < 0 ? -1 : before.keyframe(k.previous).id);
     EXPECT_EQ(r.next < 0 ? -1 : after.keyframe(r.next).id, k.next < 0 ? -1 : before.keyframe(k.next).id);
     ASSERT_EQ(after.points(slot).size(), before.points(b).size());
     for (std::size_t i = 0; i < before.points(b).size(); ++i) {
@@ -218,7 +219,7 @@ std::string memoryFile(const Rig& rig) {
       w.put<float>(0.5f);
     }
   }
-  w.put<uint32_t>(0);                                  // loops
+  w.put<uint32_t>(0);                                // loops
   for (int32_t root : {0, 1}) w.put<int32_t>(root);  // segments joined by none
   finishMapFile(out);
   return out;
@@ -246,11 +247,14 @@ TEST(MapFile, AMapOfAnotherRigOrVocabularyIsRefused) {
   const std::string file = memoryFile(isecRig({0, 1}));
   auto three = memoryFor(isecRig({0, 1, 2}), shippedVocabulary());
   EXPECT_NE(errorOf([&] { three->readMap(file, "robot.map"); })
-                .find("robot.map: the map was made by a rig of 2 cameras (720x540, 720x540), this one has 3 cameras (720x540, 720x540, 720x540)"),
+                .find("robot.map: the map was made by a rig of 2 cameras (720x540, 720x540), this one has 3 cameras "
+                      "(720x540, 720x540, 720x540)"),
             std::string::npos);
   const Vocabulary other(2, 2);
   auto stranger = memoryFor(isecRig({0, 1}), other);
-  EXPECT_NE(errorOf([&] { stranger->readMap(file, "robot.map"); }).find("robot.map: the map was made with another vocabulary"),
+  EXPECT_NE(errorOf([&] {
+              stranger->readMap(file, "robot.map");
+            }).find("robot.map: the map was made with another vocabulary"),
             std::string::npos);
 }
 
