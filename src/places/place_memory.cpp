@@ -94,7 +94,8 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
       landmark_stamp_[static_cast<std::size_t>(lm)] = kf.id;
       const Landmark& l = local.landmark(lm);
       // Only points whose position is certain anchor a place: a multi-view point (depth to about 1%), or one the
-      // back-end has seen from three keyframes; a young point triangulated across two keyframes may be off by 15%.
+      // back-end has seen from three keyframes; a young point triangulated across two keyframes is only as good as the
+      // mapper's acceptance bound on its depth.
       if (!l.metric && local.observingKeyframes(lm) < 3) continue;
       PlacePoint p;
       p.p_k = (T_k_o * l.p_w).cast<float>();

@@ -56,8 +56,8 @@ class Daemon {
   Daemon& operator=(const Daemon&) = delete;
 
   void start();
-  // Stops in order (trigger, source, assembly, processing, publishing), then fsyncs the trajectory and
-  // writes the pipeline's refined extrinsics (output.extrinsics, fsynced).
+  // Stops in order (trigger, source, assembly, processing, publishing), then fsyncs the trajectory,
+  // writes the pipeline's refined extrinsics (output.extrinsics, fsynced) and saves the map (map.save).
   // Returns false when the processing did not finish within `processing_grace_ns` (its threads are then
   // left behind, and no extrinsics are written; the trajectory of what was published is still
   // complete and synced).
