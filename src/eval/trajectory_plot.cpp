@@ -3,13 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "mcslam/core/error.hpp"
 #include "plot_drawing.hpp"
+#include "plot_view.hpp"
 
 namespace mcslam {
 
@@ -17,16 +16,11 @@ namespace {
 
 using plot::Align;
 
-// Maps the two chosen world axes into the plot rectangle with one scale (equal aspect).
+// The two world axes shown, in a plane view.
 struct View {
   int h = 0, v = 2;  // world axes shown horizontally and vertically
-  cv::Rect area;
-  double scale = 1;       // pixels per metre
-  double h0 = 0, v0 = 0;  // world coordinates at the area's left and bottom edges
-  double h1 = 0, v1 = 0;  // ... right and top edges
-  cv::Point2d px(const Vec3& p) const {
-    return {area.x + (p[h] - h0) * scale, area.y + area.height - (p[v] - v0) * scale};
-  }
+  plot::PlaneView plane;
+  cv::Point2d px(const Vec3& p) const { return plane.px(p[h], p[v]); }
 };
 
 View makeView(const std::vector<Vec3>& pts, const cv::Rect& area) {
@@ -42,41 +36,11 @@ View makeView(const std::vector<Vec3>& pts, const cv::Rect& area) {
   View view;
   view.h = std::min(order[0], order[1]);
   view.v = std::max(order[0], order[1]);
-  view.area = area;
-  const double span_h = std::max(extent[view.h], 1e-6), span_v = std::max(extent[view.v], 1e-6);
-  const double pad = 1.08;  // a margin so that the path does not touch the frame
-  view.scale = std::min(area.width / (span_h * pad), area.height / (span_v * pad));
-  const double mid_h = 0.5 * (lo[view.h] + hi[view.h]), mid_v = 0.5 * (lo[view.v] + hi[view.v]);
-  view.h0 = mid_h - 0.5 * area.width / view.scale;
-  view.h1 = mid_h + 0.5 * area.width / view.scale;
-  view.v0 = mid_v - 0.5 * area.height / view.scale;
-  view.v1 = mid_v + 0.5 * area.height / view.scale;
+  view.plane = plot::fitPlaneView({lo[view.h], lo[view.v]}, {hi[view.h], hi[view.v]}, area);
   return view;
 }
 
 const char* axisName(int axis) { return axis == 0 ? "x" : axis == 1 ? "y" : "z"; }
-
-void drawGrid(cv::Mat& img, const View& view) {
-  const double step = plot::niceStep(110.0 / view.scale);
-  const int decimals = plot::decimalsFor(step);
-  const cv::Rect& a = view.area;
-  for (double w = std::ceil(view.h0 / step) * step; w <= view.h1; w += step) {
-    const int x = static_cast<int>(std::lround(a.x + (w - view.h0) * view.scale));
-    cv::line(img, {x, a.y}, {x, a.y + a.height}, plot::kGrid, 1);
-    cv::line(img, {x, a.y + a.height}, {x, a.y + a.height + 5}, plot::kAxis, 1);
-    plot::text(img, plot::formatNumber(w, decimals), x, a.y + a.height + 24, 0.5, plot::kText, 1, Align::Centre);
-  }
-  for (double w = std::ceil(view.v0 / step) * step; w <= view.v1; w += step) {
-    const int y = static_cast<int>(std::lround(a.y + a.height - (w - view.v0) * view.scale));
-    cv::line(img, {a.x, y}, {a.x + a.width, y}, plot::kGrid, 1);
-    cv::line(img, {a.x - 5, y}, {a.x, y}, plot::kAxis, 1);
-    plot::text(img, plot::formatNumber(w, decimals), a.x - 9, y + 6, 0.5, plot::kText, 1, Align::Right);
-  }
-  cv::rectangle(img, a, plot::kAxis, 1);
-  plot::text(img, std::string(axisName(view.h)) + " [m]", a.x + a.width / 2, a.y + a.height + 56, 0.65, plot::kText, 1,
-             Align::Centre);
-  plot::verticalText(img, std::string(axisName(view.v)) + " [m]", a.x - 72, a.y + a.height / 2, 0.65, plot::kText);
-}
 
 struct ErrorRange {
   double lo = 0, hi = 0;
@@ -125,28 +89,15 @@ void endMarker(cv::Mat& img, cv::Point2d p) {
   cv::rectangle(img, p - d, p + d, plot::kWhite, 1, cv::LINE_AA);
 }
 
-// Puts the legend in the corner of the plot area that covers the fewest trajectory points.
 void drawLegend(cv::Mat& img, const View& view, const TrajectoryPlot& plot, const std::vector<Vec3>& all) {
   const std::array<std::string, 4> labels{plot.reference_label, plot.estimate_label, "start", "end"};
   int text_w = 0;
   for (const auto& l : labels) text_w = std::max(text_w, plot::textSize(l, 0.55).width);
   const cv::Size box(text_w + 78, 4 * 26 + 14);
-  const cv::Rect& a = view.area;
-  const int m = 12;
-  const std::array<cv::Point, 4> corners{cv::Point(a.x + m, a.y + m), cv::Point(a.br().x - m - box.width, a.y + m),
-                                         cv::Point(a.x + m, a.br().y - m - box.height),
-                                         cv::Point(a.br().x - m - box.width, a.br().y - m - box.height)};
-  std::size_t best = 0, best_count = std::numeric_limits<std::size_t>::max();
-  for (std::size_t c = 0; c < corners.size(); ++c) {
-    const cv::Rect r(corners[c], box);
-    std::size_t count = 0;
-    for (const Vec3& p : all) count += r.contains(view.px(p)) ? 1 : 0;
-    if (count < best_count) {
-      best = c;
-      best_count = count;
-    }
-  }
-  const cv::Rect r(corners[best], box);
+  std::vector<cv::Point2d> drawn;
+  drawn.reserve(all.size());
+  for (const Vec3& p : all) drawn.push_back(view.px(p));
+  const cv::Rect r = plot::quietestCorner(view.plane, box, drawn);
   cv::rectangle(img, r, plot::kWhite, cv::FILLED);
   cv::rectangle(img, r, plot::kAxis, 1);
   const int x0 = r.x + 12, x1 = r.x + 54, tx = r.x + 66;
@@ -203,24 +154,20 @@ void writeTrajectoryPlot(const std::string& png_path, const TrajectoryPlot& plot
   const int right = range.valid ? 150 : 40;
   const View view = makeView(all, cv::Rect(100, 96, width - 100 - right, height - 96 - 80));
 
-  drawGrid(img, view);
+  plot::drawPlaneGrid(img, view.plane, std::string(axisName(view.h)) + " [m]", std::string(axisName(view.v)) + " [m]");
   drawTrajectories(img, view, plot, range);
   const std::vector<Vec3>& marked = plot.estimate.empty() ? plot.reference : plot.estimate;
   startMarker(img, view.px(marked.front()));
   endMarker(img, view.px(marked.back()));
   drawLegend(img, view, plot, all);
   if (range.valid) {
-    drawColourBar(img, cv::Rect(view.area.br().x + 32, view.area.y + 30, 22, view.area.height - 60), range,
-                  plot.error_label);
+    drawColourBar(img, cv::Rect(view.plane.area.br().x + 32, view.plane.area.y + 30, 22, view.plane.area.height - 60),
+                  range, plot.error_label);
   }
   plot::text(img, plot.title, width / 2, 42, 0.85, plot::kBlack, 1, Align::Centre);
   plot::text(img, plot.subtitle, width / 2, 74, 0.5, plot::kText, 1, Align::Centre);
 
-  std::vector<uchar> png;
-  if (!cv::imencode(".png", img, png)) throw InputError(png_path + ": cannot encode the plot as PNG");
-  std::ofstream out(png_path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  if (!out) throw InputError(png_path + ": cannot write the plot");
+  plot::writePng(png_path, img);
 }
 
 }  // namespace mcslam

@@ -169,26 +169,23 @@ std::size_t LoopCloser::maxWrittenBytes() const {
   return sizeof(uint32_t) + loops_.size() * kLoopBytes + PlaceMap::kMaxSegments * sizeof(int32_t);
 }
 
-void LoopCloser::write(ByteWriter& out, int segments) const {
-  out.put<uint32_t>(static_cast<uint32_t>(loop_count_));
-  for (int i = 0; i < loop_count_; ++i) {
-    const LoopEdge& e = loops_[static_cast<std::size_t>(i)];
+void putLoops(ByteWriter& out, std::span<const LoopEdge> loops, std::span<const int32_t> roots) {
+  out.put<uint32_t>(static_cast<uint32_t>(loops.size()));
+  for (const LoopEdge& e : loops) {
     out.put<int64_t>(e.a);
     out.put<int64_t>(e.b);
     putPose(out, e.T_a_b);
     for (int k = 0; k < 6; ++k) out.put<double>(e.sigma[k]);
   }
-  for (int s = 0; s < segments; ++s) out.put<int32_t>(segment_root_[static_cast<std::size_t>(s)]);
+  for (const int32_t root : roots) out.put<int32_t>(root);
 }
 
-void LoopCloser::read(ByteReader& in, int segments) {
-  clear();
+int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span<int32_t> roots) {
   const auto count = in.take<uint32_t>("the loop count");
-  if (count > loops_.size())
-    in.fail(std::to_string(count) + " loops, more than places.max_loops (" + std::to_string(loops_.size()) + ")");
-  loop_count_ = static_cast<int>(count);
-  for (int i = 0; i < loop_count_; ++i) {
-    LoopEdge& e = loops_[static_cast<std::size_t>(i)];
+  if (count > loops.size())
+    in.fail(std::to_string(count) + " loops, more than places.max_loops (" + std::to_string(loops.size()) + ")");
+  for (uint32_t i = 0; i < count; ++i) {
+    LoopEdge& e = loops[i];
     e.a = in.take<int64_t>("a loop's keyframe");
     e.b = in.take<int64_t>("a loop's keyframe");
     e.T_a_b = takePose(in, "a loop's relative pose");
@@ -199,8 +196,19 @@ void LoopCloser::read(ByteReader& in, int segments) {
   for (int s = 0; s < segments; ++s) {
     const auto r = in.take<int32_t>("a segment's root");
     if (r < 0 || r > s) in.fail("segment " + std::to_string(s) + " joined to segment " + std::to_string(r));
-    segment_root_[static_cast<std::size_t>(s)] = r;
+    roots[static_cast<std::size_t>(s)] = r;
   }
+  return static_cast<int>(count);
+}
+
+void LoopCloser::write(ByteWriter& out, int segments) const {
+  putLoops(out, {loops_.data(), static_cast<std::size_t>(loop_count_)},
+           {segment_root_.data(), static_cast<std::size_t>(segments)});
+}
+
+void LoopCloser::read(ByteReader& in, int segments) {
+  clear();
+  loop_count_ = takeLoops(in, segments, loops_, segment_root_);
 }
 
 void LoopCloser::buildGraph(const PlaceMap& map) {

@@ -1,5 +1,6 @@
 #include "mcslam/places/map_file.hpp"
 
+#include <cmath>
 #include <cstring>
 
 #include "mcslam/core/checksum.hpp"
@@ -82,6 +83,31 @@ MapFileHeader openMapFile(std::string_view bytes, const std::string& name, ByteR
   h.segments = payload.take<uint32_t>("the segment count");
   h.loops = payload.take<uint32_t>("the loop count");
   return h;
+}
+
+void putKeyframeWords(ByteWriter& out, std::span<const BowEntry> entries) {
+  out.put<uint32_t>(static_cast<uint32_t>(entries.size()));
+  for (const BowEntry& e : entries) {
+    out.put<int32_t>(e.word);
+    out.put<float>(e.weight);
+  }
+}
+
+void takeKeyframeWords(ByteReader& in, int vocabulary_words, int64_t keyframe_id, const char* capacity_setting,
+                       BowVector& out) {
+  const auto count = in.take<uint32_t>("a keyframe's word count");
+  if (count > static_cast<uint32_t>(out.capacity()))
+    in.fail("keyframe " + std::to_string(keyframe_id) + " has " + std::to_string(count) + " words, more than " +
+            capacity_setting + " (" + std::to_string(out.capacity()) + ")");
+  out.clear();
+  for (uint32_t i = 0; i < count; ++i) {
+    const auto word = in.take<WordId>("a word");
+    const auto weight = in.take<float>("a word's weight");
+    const bool in_order = out.size() == 0 || out.entries().back().word < word;
+    if (word < 0 || word >= vocabulary_words || !in_order || !(weight >= 0) || !std::isfinite(weight))
+      in.fail("keyframe " + std::to_string(keyframe_id) + " has a word the vocabulary cannot give");
+    out.push(word, weight);
+  }
 }
 
 }  // namespace mcslam

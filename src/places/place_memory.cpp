@@ -271,12 +271,7 @@ void PlaceMemory::writeMap(std::string& out) const {
   map_.write(w);
   for (int slot = 0; slot < map_.capacity(); ++slot) {  // the order PlaceMap::write keeps
     if (!map_.keyframe(slot).alive) continue;
-    const std::span<const BowEntry> entries = database_.entries(slot);
-    w.put<uint32_t>(static_cast<uint32_t>(entries.size()));
-    for (const BowEntry& e : entries) {
-      w.put<int32_t>(e.word);
-      w.put<float>(e.weight);
-    }
+    putKeyframeWords(w, database_.entries(slot));
   }
   loop_closer_.write(w, map_.segments());
   finishMapFile(out);
@@ -305,19 +300,8 @@ void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool 
   database_.clear();
   int64_t last_landmark = -1;
   for (int slot = 0; slot < map_.size(); ++slot) {
-    const auto count = in.take<uint32_t>("a keyframe's word count");
-    if (count > static_cast<uint32_t>(file_words_.capacity()))
-      in.fail("a keyframe of " + std::to_string(count) + " words, more than places.max_words_per_keyframe (" +
-              std::to_string(file_words_.capacity()) + ")");
-    file_words_.clear();
-    for (uint32_t i = 0; i < count; ++i) {
-      const auto word = in.take<WordId>("a word");
-      const auto weight = in.take<float>("a word's weight");
-      const bool in_order = file_words_.size() == 0 || file_words_.entries().back().word < word;
-      if (word < 0 || word >= vocabulary_.wordCount() || !in_order || !(weight >= 0) || !std::isfinite(weight))
-        in.fail("keyframe " + std::to_string(map_.keyframe(slot).id) + " has a word the vocabulary cannot give");
-      file_words_.push(word, weight);
-    }
+    takeKeyframeWords(in, vocabulary_.wordCount(), map_.keyframe(slot).id, "places.max_words_per_keyframe",
+                      file_words_);
     database_.insert(slot, file_words_);
     for (const PlacePoint& p : map_.points(slot)) last_landmark = std::max(last_landmark, p.landmark_id);
   }

@@ -9,6 +9,7 @@
 #include "alloc_testing.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/error.hpp"
+#include "mcslam/places/map_contents.hpp"
 #include "mcslam/places/map_file.hpp"
 #include "mcslam/places/place_map.hpp"
 #include "mcslam/places/place_memory.hpp"
@@ -241,6 +242,23 @@ TEST(MapFile, APlaceMemoryReadsAMapAndWritesTheSameBytesWithoutAllocating) {
     EXPECT_EQ(scope.count(), 0u);
   }
   EXPECT_TRUE(again == file);
+}
+
+// Tools read a map whole, sized by the file: the same keyframes, words and joined segments; a cut file is refused.
+TEST(MapFile, AToolReadsAWholeMapWithoutCapacities) {
+  const std::string file = memoryFile(isecRig({0, 1}));
+  const MapContents c = readMapContents(file, "robot.map");
+  EXPECT_EQ(c.file_bytes, file.size());
+  EXPECT_EQ(c.header.cameras.size(), 2u);
+  ASSERT_EQ(c.map->size(), 4);
+  EXPECT_EQ(c.map->segments(), 2);
+  EXPECT_EQ(c.words, (std::vector<uint32_t>{2, 2, 2, 2}));
+  EXPECT_TRUE(c.loops.empty());
+  EXPECT_EQ(c.segment_roots, (std::vector<int32_t>{0, 1}));
+  for (std::size_t n : {file.size() - 1, file.size() / 2, std::size_t{20}}) {
+    std::string cut = file.substr(0, n);
+    EXPECT_NE(errorOf([&] { readMapContents(cut, "cut.map"); }).find("cut.map: "), std::string::npos) << n;
+  }
 }
 
 TEST(MapFile, AMapOfAnotherRigOrVocabularyIsRefused) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <opencv2/imgcodecs.hpp>
 
 #include "mcslam/dataset/trajectory.hpp"
 #include "mcslam/eval/trajectory_metrics.hpp"
@@ -102,13 +103,24 @@ TEST_F(Relocalization, TheSecondHalfOfARunLocalizesInTheMapTheFirstHalfSaved) {
 }
 
 // Building on a saved map: the second run adds its keyframes to the loaded ones, in the loaded map's frame.
+// mcslam-map describes the map the second run saved and draws it.
 TEST_F(Relocalization, ASecondRunBuildsOnTheSavedMap) {
-  const std::string map = dir_->file("build.map");
+  const std::string map = dir_->file("build.map"), grown = dir_->file("grown.map");
   const Run first = run("build1", "--frames 100 --map-out " + map);
-  const Run second = run("build2", "--start 100 --map-in " + map);
+  const Run second = run("build2", "--start 100 --map-in " + map + " --map-out " + grown);
   EXPECT_GT(jsonInt(second.stats, "place_keyframes"), jsonInt(first.stats, "place_keyframes") + 10);
   EXPECT_LE(jsonInt(second.stats, "placed_frame"), 102) << second.stats;
   EXPECT_EQ(jsonInt(second.stats, "segments"), 2);
+
+  std::string info;
+  const std::string png = dir_->file("grown.png");
+  ASSERT_EQ(test::runCommand(test::binPath("mcslam-map") + " info " + grown + " --json --plot " + png, &info), 0)
+      << info;
+  EXPECT_EQ(jsonInt(info, "keyframes"), jsonInt(second.stats, "place_keyframes")) << info;
+  EXPECT_EQ(jsonInt(info, "placed_segments"), 2) << info;  // the second run's, in the first's world
+  const cv::Mat drawn = cv::imread(png);
+  EXPECT_EQ(drawn.cols, 1400);
+  EXPECT_EQ(drawn.rows, 1000);
 }
 
 TEST_F(Relocalization, AnUnreadableMapEndsTheRunWithOneMessageNamingIt) {
@@ -119,6 +131,8 @@ TEST_F(Relocalization, AnUnreadableMapEndsTheRunWithOneMessageNamingIt) {
                 test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --map-in " + map, &out),
             2);
   EXPECT_NE(out.find("mcslam-run: " + map + ": not an mcslam map file"), std::string::npos) << out;
+  EXPECT_EQ(test::runCommand(test::binPath("mcslam-map") + " info " + map, &out), 2);
+  EXPECT_NE(out.find("mcslam-map: " + map + ": not an mcslam map file"), std::string::npos) << out;
   EXPECT_EQ(
       test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --localize", &out),
       2);

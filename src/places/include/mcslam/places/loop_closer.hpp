@@ -7,6 +7,7 @@
 // by the odometry's relative poses), which is solved; the keyframes (and the points anchored in them) take the
 // solution, and every segment's T_w_o follows its newest keyframe. Fixed memory.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "mcslam/backend/pose_graph.hpp"
@@ -26,6 +27,19 @@ struct LoopStats {
   double last_correction_m = 0, last_correction_deg = 0;
   double last_solve_ms = 0;
 };
+
+// A loop: keyframe b seen from keyframe a, with the uncertainty of the verification.
+struct LoopEdge {
+  int64_t a = -1, b = -1;  // place keyframe ids
+  SE3 T_a_b;
+  Vec6 sigma = Vec6::Ones();
+};
+
+// The map file's loops part: the loops, then each of the map's segments' root (which segment the loops joined it
+// to). takeLoops() fills `loops` and `roots` (sized by the caller; `roots` at least `segments`) and returns the
+// loop count; InputError from `in` for more loops than `loops` holds or a root that is no union.
+void putLoops(ByteWriter& out, std::span<const LoopEdge> loops, std::span<const int32_t> roots);
+int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span<int32_t> roots);
 
 class LoopCloser {
  public:
@@ -49,11 +63,6 @@ class LoopCloser {
   std::size_t maxWrittenBytes() const;
 
  private:
-  struct LoopEdge {
-    int64_t a = -1, b = -1;  // place keyframe ids
-    SE3 T_a_b;
-    Vec6 sigma = Vec6::Ones();
-  };
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
   bool closesALoop(const PlaceMap& map, int candidate, int slot) const;
   // Solves the pose graph of the whole map with the loops so far; keyframes and segments' frames take the solution.

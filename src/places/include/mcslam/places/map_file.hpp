@@ -9,11 +9,13 @@
 // image size), the vocabulary (word count and fingerprint) and the counts. Written whole or not at all
 // (writeFileSynced): a crash mid-save keeps the previous file.
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "mcslam/core/binary_io.hpp"
+#include "mcslam/recognition/bow_vector.hpp"
 
 namespace mcslam {
 
@@ -44,6 +46,13 @@ void finishMapFile(std::string& out);
 // Checks the envelope of `bytes` (the file `name`: magic, version, size, checksum), reads the header, and leaves
 // `payload` positioned after it. InputError naming the file and the fault.
 MapFileHeader openMapFile(std::string_view bytes, const std::string& name, ByteReader& payload);
+
+// One keyframe's words in the payload: u32 count, then u32 word and f32 weight each, words increasing.
+void putKeyframeWords(ByteWriter& out, std::span<const BowEntry> entries);
+// Reads them into `out` (its capacity bounds the count: `capacity_setting` names where it comes from). InputError
+// from `in` naming keyframe `keyframe_id` for a word outside `vocabulary_words`, out of order or weighted wrongly.
+void takeKeyframeWords(ByteReader& in, int vocabulary_words, int64_t keyframe_id, const char* capacity_setting,
+                       BowVector& out);
 
 // The largest map file any capacities could ask for: a bound on what is read.
 constexpr std::size_t kMaxMapFileBytes = std::size_t{16} << 30;
