@@ -192,6 +192,7 @@ DaemonStats Daemon::stats() const {
   if (map_saver_) {
     s.map_saves = map_saver_->saves();
     s.map_save_failures = map_saver_->failures();
+    s.allocations_after_warmup += map_saver_->allocationsSinceWarmup();
   }
   return s;
 }

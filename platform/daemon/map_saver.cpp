@@ -2,12 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
-#include "mcslam/core/synced_file.hpp"
-
 namespace mcslam::platform {
 
 MapSaver::MapSaver(std::string path, double interval_s, std::size_t max_bytes)
-    : path_(std::move(path)), interval_ns_(static_cast<int64_t>(interval_s * 1e9)) {
+    : target_(path), interval_ns_(static_cast<int64_t>(interval_s * 1e9)) {
   buffer_.reserve(max_bytes);
 }
 
@@ -46,7 +44,7 @@ void MapSaver::saveNow(const FrameProcessor& processor) {
   wake_.notify_one();
   if (thread_.joinable()) thread_.join();  // finishes a save under way
   if (!processor.writeMap(buffer_)) return;
-  if (write()) spdlog::info("map saved to {} ({} bytes)", path_, buffer_.size());
+  if (write()) spdlog::info("map saved to {} ({} bytes)", target_.path, buffer_.size());
 }
 
 void MapSaver::loop() {
@@ -58,13 +56,14 @@ void MapSaver::loop() {
       pending_ = false;
     }
     write();
+    meter_.note(true);
     busy_.store(false, std::memory_order_release);
   }
 }
 
 bool MapSaver::write() {
   std::string error;
-  if (writeFileSynced(path_, buffer_, &error)) {
+  if (writeFileSynced(target_, buffer_, &error)) {
     saves_.fetch_add(1, std::memory_order_relaxed);
     return true;
   }

@@ -19,19 +19,20 @@ void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char
   const double per_frame = s.frames_after_warmup ? static_cast<double>(s.allocations_after_warmup) /
                                                        static_cast<double>(s.frames_after_warmup)
                                                  : 0.0;
-  std::snprintf(out, size,
-                "%.1f Hz, %s%s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
-                "cameras %s%s, map %lld keyframes, relocalizations %llu, loop closures %llu, merges %llu, "
-                "world revision %u, map saves %llu (failed %llu)",
-                rate_hz, trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "",
-                static_cast<unsigned long long>(s.processed),
-                static_cast<unsigned long long>(s.rig_drops + s.camera_drops),
-                static_cast<unsigned long long>(s.partial_frames), static_cast<double>(s.latency_p50_ns) * 1e-6,
-                per_frame, s.warm ? "" : " (warming up)", health, s.source_finished ? ", source finished" : "",
-                static_cast<long long>(s.places.keyframes), static_cast<unsigned long long>(s.places.relocalizations),
-                static_cast<unsigned long long>(s.places.loop_closures),
-                static_cast<unsigned long long>(s.places.map_merges), static_cast<unsigned>(s.places.world_revision),
-                static_cast<unsigned long long>(s.map_saves), static_cast<unsigned long long>(s.map_save_failures));
+  std::snprintf(
+      out, size,
+      "%.1f Hz, %s%s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
+      "cameras %s%s, map %lld keyframes (culled %llu), relocalizations %llu, loop closures %llu, merges %llu, "
+      "world revision %u, map saves %llu (failed %llu)",
+      rate_hz, trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "",
+      static_cast<unsigned long long>(s.processed), static_cast<unsigned long long>(s.rig_drops + s.camera_drops),
+      static_cast<unsigned long long>(s.partial_frames), static_cast<double>(s.latency_p50_ns) * 1e-6, per_frame,
+      s.warm ? "" : " (warming up)", health, s.source_finished ? ", source finished" : "",
+      static_cast<long long>(s.places.keyframes), static_cast<unsigned long long>(s.places.keyframes_culled),
+      static_cast<unsigned long long>(s.places.relocalizations),
+      static_cast<unsigned long long>(s.places.loop_closures), static_cast<unsigned long long>(s.places.map_merges),
+      static_cast<unsigned>(s.places.world_revision), static_cast<unsigned long long>(s.map_saves),
+      static_cast<unsigned long long>(s.map_save_failures));
 }
 
 namespace {

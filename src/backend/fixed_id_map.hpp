@@ -1,6 +1,7 @@
 #pragma once
 // Caller id -> pool slot, with a capacity fixed at construction (no allocation on insert).
 // Open addressing with linear probing and backward-shift deletion (no tombstones).
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -16,6 +17,8 @@ class FixedIdMap {
     values_.assign(n, kEmpty);
     mask_ = n - 1;
   }
+
+  void clear() { std::fill(values_.begin(), values_.end(), kEmpty); }
 
   // -1 when absent.
   int find(int64_t key) const {

@@ -28,6 +28,15 @@ MarginalizationPrior::MarginalizationPrior(const WindowStorage& window) {
   V_.setZero(6 * n, 6 * n);
 }
 
+void MarginalizationPrior::clear() {
+  H.setZero();
+  b.setZero();
+  c = 0;
+  empty = true;
+  d_current_.setZero();
+  d_eval_.setZero();
+}
+
 void MarginalizationPrior::stackCurrent(const WindowStorage& window, Eigen::VectorXd& d) const {
   for (int cam = 0; cam < static_cast<int>(ext_var_of_camera_.size()); ++cam) {
     const int v = ext_var_of_camera_[cam];

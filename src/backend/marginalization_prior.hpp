@@ -17,6 +17,7 @@ namespace mcslam::backend {
 class MarginalizationPrior final : public WindowTerm {
  public:
   explicit MarginalizationPrior(const WindowStorage& window);
+  void clear();  // nothing known, as constructed
   int dim() const { return static_cast<int>(b.size()); }
 
   void linearize(const WindowVariables& v) override;

@@ -53,7 +53,8 @@ const Rig& validated(const Rig& rig, const WindowCapacity& cap, const SolverOpti
 
 struct SlidingWindowSolver::Impl {
   Impl(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& opts)
-      : options(opts),
+      : initial_options(opts),
+        options(opts),
         window(validated(rig, capacity, opts), capacity, opts),
         prior(window),
         linearization(window, opts),
@@ -67,6 +68,7 @@ struct SlidingWindowSolver::Impl {
 
   SolveSummary solve(int max_iterations);
   void classifyOutliers();
+  const SolverOptions initial_options;
   SolverOptions options;
   WindowStorage window;
   MarginalizationPrior prior;
@@ -187,6 +189,15 @@ Status SlidingWindowSolver::removeObservation(const ObservationKey& key) {
   return impl_->window.removeObservation(key);
 }
 Status SlidingWindowSolver::removeLandmark(int64_t id) { return impl_->window.removeLandmark(id); }
+
+void SlidingWindowSolver::clear() {
+  Impl& m = *impl_;
+  m.window.clear();
+  m.prior.clear();
+  m.options = m.initial_options;
+  m.outliers.clear();
+  m.marginalized.clear();
+}
 
 Status SlidingWindowSolver::setKeyframeFixed(int64_t id, bool fixed) {
   const int s = impl_->window.keyframeSlot(id);

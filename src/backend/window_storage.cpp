@@ -23,6 +23,25 @@ WindowStorage::WindowStorage(const Rig& rig, const WindowCapacity& capacity, con
   }
 }
 
+void WindowStorage::clear() {
+  for (KeyframeState& k : keyframes) k = KeyframeState{};
+  for (LandmarkState& l : landmarks) l = LandmarkState{};
+  for (ObservationState& o : observations) o = ObservationState{};
+  for (ExtrinsicState& e : extrinsics) {
+    e.T_lin = e.T = e.T_calib;
+    e.d.setZero();
+    e.in_prior = false;
+    e.calibration_prior = true;
+  }
+  num_keyframes = num_landmarks = num_observations = 0;
+  keyframe_slots_.refill();
+  landmark_slots_.refill();
+  observation_slots_.refill();
+  keyframe_ids_.clear();
+  landmark_ids_.clear();
+  next_sequence_ = 0;
+}
+
 Status WindowStorage::addKeyframe(int64_t id, const SE3& T_w_b) {
   if (keyframe_ids_.find(id) >= 0) return Status::DuplicateId;
   if (keyframe_slots_.empty()) return Status::CapacityExceeded;

@@ -52,9 +52,14 @@ struct ExtrinsicState {
 // Free slots are kept on a stack, so slots are reused without allocating.
 class SlotPool {
  public:
-  explicit SlotPool(int capacity) {
+  explicit SlotPool(int capacity) : capacity_(capacity) {
     free_.reserve(capacity);
-    for (int i = capacity - 1; i >= 0; --i) free_.push_back(i);
+    refill();
+  }
+  // Every slot free again, the lowest taken first.
+  void refill() {
+    free_.clear();
+    for (int i = capacity_ - 1; i >= 0; --i) free_.push_back(i);
   }
   bool empty() const { return free_.empty(); }
   int take() {
@@ -65,12 +70,15 @@ class SlotPool {
   void give(int s) { free_.push_back(s); }
 
  private:
+  int capacity_ = 0;
   std::vector<int> free_;
 };
 
 class WindowStorage {
  public:
   WindowStorage(const Rig& rig, const WindowCapacity& capacity, const SolverOptions& options);
+  // Empty, as constructed: no keyframe, landmark or observation; every extrinsic back at its calibration.
+  void clear();
 
   Status addKeyframe(int64_t id, const SE3& T_w_b);
   Status addLandmark(int64_t id, const Vec3& p_w);

@@ -32,10 +32,18 @@ bool writeAll(int fd, std::string_view bytes) {
 
 }  // namespace
 
+SyncedFileTarget::SyncedFileTarget(const std::string& file) : path(file), tmp(file + ".tmp") {
+  const std::string parent = std::filesystem::path(file).parent_path().string();
+  folder = parent.empty() ? std::string(1, '.') : parent;
+}
+
 bool writeFileSynced(const std::string& path, std::string_view bytes, std::string* error) {
-  const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return fail(error, "cannot create", tmp);
+  return writeFileSynced(SyncedFileTarget(path), bytes, error);
+}
+
+bool writeFileSynced(const SyncedFileTarget& target, std::string_view bytes, std::string* error) {
+  const int fd = ::open(target.tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return fail(error, "cannot create", target.tmp);
   const char* failed_step = nullptr;
   if (!writeAll(fd, bytes)) {
     failed_step = "cannot write";
@@ -43,25 +51,23 @@ bool writeFileSynced(const std::string& path, std::string_view bytes, std::strin
     failed_step = "cannot fsync";
   }
   if (failed_step) {
-    fail(error, failed_step, tmp);
+    fail(error, failed_step, target.tmp);
     ::close(fd);
-    ::unlink(tmp.c_str());
+    ::unlink(target.tmp.c_str());
     return false;
   }
   ::close(fd);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    fail(error, "cannot rename to", path);
-    ::unlink(tmp.c_str());
+  if (::rename(target.tmp.c_str(), target.path.c_str()) != 0) {
+    fail(error, "cannot rename to", target.path);
+    ::unlink(target.tmp.c_str());
     return false;
   }
   // The rename itself is durable only once the folder is synced.
-  const std::string parent = std::filesystem::path(path).parent_path().string();
-  const std::string dir = parent.empty() ? std::string(1, '.') : parent;
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0) return fail(error, "cannot open folder", dir);
+  const int dfd = ::open(target.folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd < 0) return fail(error, "cannot open folder", target.folder);
   const bool synced = ::fsync(dfd) == 0;
   ::close(dfd);
-  return synced || fail(error, "cannot fsync folder", dir);
+  return synced || fail(error, "cannot fsync folder", target.folder);
 }
 
 }  // namespace mcslam

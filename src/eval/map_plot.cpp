@@ -137,7 +137,8 @@ void drawLegend(cv::Mat& img, const plot::PlaneView& view, const MapPlot& plot) 
 }  // namespace
 
 void writeMapPlot(const std::string& png_path, const MapPlot& plot, int width, int height) {
-  const bool any = std::any_of(plot.paths.begin(), plot.paths.end(), [](const auto& p) { return !p.keyframes.empty(); });
+  const bool any =
+      std::any_of(plot.paths.begin(), plot.paths.end(), [](const auto& p) { return !p.keyframes.empty(); });
   if (!any) throw InputError(png_path + ": nothing to plot (the map has no keyframe)");
   cv::Mat img(height, width, CV_8UC3, plot::kWhite);
   const plot::PlaneView view = viewOf(plot, cv::Rect(100, 96, width - 100 - 40, height - 96 - 80));

@@ -57,11 +57,9 @@ void WindowBridge::reset() {
   if (worker_) worker_->wait();
   solving_ = false;  // the window is dropped with the map: its last result does not matter
   if (!solver_) return;
-  // A fresh window (the old one's keyframes and landmarks are gone with the map), on the same prior, starting from
-  // the current extrinsics.
-  solver_.reset();
-  solver_ = std::make_unique<backend::SlidingWindowSolver>(
-      calibration_, windowCapacity(options_, rig_state_.cameras(), capacity_), solverOptions(options_, monocular_));
+  // An empty window (the old one's keyframes and landmarks are gone with the map), on the same prior, starting from
+  // the current extrinsics. Cleared, not rebuilt: a relocalization allocates nothing.
+  solver_->clear();
   for (int c = 0; c < rig_state_.cameras(); ++c) {  // refused where not refined
     solver_->setExtrinsic(c, rig_state_.T_b_c(c), !calibration_dropped_[c]);
   }

@@ -111,6 +111,7 @@ bool SlamPipeline::placeCounters(PlaceCounters& out) const {
   out.map_merges = places_->loopStats().merges;
   out.localization_corrections = places_->stats().localization_corrections;
   out.keyframes = places_->map().size();
+  out.keyframes_culled = places_->stats().keyframes_culled;
   out.world_revision = places_->worldRevision();
   return true;
 }

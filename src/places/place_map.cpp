@@ -1,6 +1,7 @@
 #include "mcslam/places/place_map.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "pose_io.hpp"
 
@@ -83,6 +84,43 @@ void PlaceMap::eraseKeyframe(int slot) {
   k = PlaceKeyframe{};
   free_[static_cast<std::size_t>(free_count_++)] = slot;
   --live_;
+}
+
+int PlaceMap::leastNeededKeyframe(std::span<const int64_t> kept) const {
+  const auto inner = [&](const PlaceKeyframe& k) { return k.alive && k.previous >= 0 && k.next >= 0; };
+  const auto gap = [&](const PlaceKeyframe& k, double& metres, double& radians) {
+    const PlaceKeyframe& a = keyframes_[static_cast<std::size_t>(k.previous)];
+    const PlaceKeyframe& b = keyframes_[static_cast<std::size_t>(k.next)];
+    metres = (b.T_w_k.t - a.T_w_k.t).norm();
+    radians = rotationAngle(a.T_w_k.R, b.T_w_k.R);
+  };
+  double sum_m = 0, sum_rad = 0;
+  int inner_count = 0;
+  for (const PlaceKeyframe& k : keyframes_) {
+    if (!inner(k)) continue;
+    double m = 0, rad = 0;
+    gap(k, m, rad);
+    sum_m += m;
+    sum_rad += rad;
+    ++inner_count;
+  }
+  if (inner_count == 0) return -1;
+  // A map that never turned (or never moved) ranks by the other measure alone.
+  const double per_m = sum_m > 0 ? inner_count / sum_m : 0, per_rad = sum_rad > 0 ? inner_count / sum_rad : 0;
+  int best = -1;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (int slot = 0; slot < capacity(); ++slot) {
+    const PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
+    if (!inner(k) || std::binary_search(kept.begin(), kept.end(), k.id)) continue;
+    double m = 0, rad = 0;
+    gap(k, m, rad);
+    const double score = m * per_m + rad * per_rad;
+    if (score < best_score) {
+      best_score = score;
+      best = slot;
+    }
+  }
+  return best;
 }
 
 void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {

@@ -19,6 +19,7 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       seeds_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
       landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1),
       file_words_(options.max_words_per_keyframe),
+      kept_ids_(2 * static_cast<std::size_t>(options.max_loops)),
       root_placed_(PlaceMap::kMaxSegments),
       vocabulary_fingerprint_(vocabularyFingerprint(vocabulary)) {
   for (int c = 0; c < rig.size(); ++c)
@@ -79,6 +80,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   const Map& local = odometry.map();
   const Keyframe& kf = local.keyframe(odometry_slot);
   const SE3 T_w_k = map_.segmentPose(segment_) * kf.T_w_b;
+  if (map_.size() == map_.capacity()) makeRoom();
   const int slot = map_.createKeyframe(segment_, kf.t, kf.frame_index, T_w_k, kf.T_w_b);
   if (slot < 0) {
     ++stats_.keyframes_dropped;
@@ -120,6 +122,21 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
       propagatePlacement();
     }
   }
+}
+
+void PlaceMemory::makeRoom() {
+  std::size_t n = 0;
+  for (const LoopEdge& e : loop_closer_.loopEdges()) {
+    kept_ids_[n++] = e.a;
+    kept_ids_[n++] = e.b;
+  }
+  std::sort(kept_ids_.begin(), kept_ids_.begin() + static_cast<std::ptrdiff_t>(n));
+  const int slot = map_.leastNeededKeyframe({kept_ids_.data(), n});
+  if (slot < 0) return;
+  database_.erase(slot);
+  map_.eraseKeyframe(slot);
+  if (last_place_keyframe_ == slot) last_place_keyframe_ = -1;
+  ++stats_.keyframes_culled;
 }
 
 void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out) {

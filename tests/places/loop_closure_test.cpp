@@ -11,6 +11,7 @@
 #include <memory>
 #include <regex>
 
+#include "alloc_testing.hpp"
 #include "mcslam/dataset/trajectory.hpp"
 #include "test_support.hpp"
 
@@ -88,6 +89,7 @@ class LoopClosure : public ::testing::Test {
         << r.log;
     r.keyframes = readTumTrajectory(kf);
     r.stats = test::readFile(stats);
+    test::expectRunAllocatedNothing(r.stats);
     return r;
   }
   static std::unique_ptr<test::TempDir> dir_;

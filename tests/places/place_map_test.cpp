@@ -2,7 +2,10 @@
 // capacity honoured, nothing allocated after construction.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
 #include "alloc_testing.hpp"
+
 #include "mcslam/places/place_map.hpp"
 
 namespace mcslam {
@@ -68,6 +71,36 @@ TEST(PlaceMap, AFullMapRefusesAKeyframeAndAllocatesNothing) {
   map.eraseKeyframe(1);
   EXPECT_EQ(map.createKeyframe(s, 9, 9, SE3(), SE3()), 1);
   EXPECT_EQ(scope.count(), 0u);
+}
+
+// Keyframes along x at `xs`, turned about z by `yaw_deg`, in one segment; returns their slots.
+std::vector<int> chain(PlaceMap& map, const std::vector<double>& xs, const std::vector<double>& yaw_deg) {
+  const int32_t s = map.createSegment(SE3());
+  std::vector<int> slots;
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    const SE3 T(so3Exp(Vec3(0, 0, yaw_deg[i] * M_PI / 180)), Vec3(xs[i], 0, 0));
+    slots.push_back(map.createKeyframe(s, static_cast<Timestamp>(i), i, T, T));
+  }
+  return slots;
+}
+
+// Where the rig lingered goes first; ends and the kept keyframes (loops') stay.
+TEST(PlaceMap, TheLeastNeededKeyframeIsWhereTheRigLingered) {
+  PlaceMap map(8, 1);
+  const std::vector<int> k = chain(map, {0, 1, 2, 2.1, 2.2, 3, 4}, {0, 0, 0, 0, 0, 0, 0});
+  EXPECT_EQ(map.leastNeededKeyframe({}), k[3]);  // its neighbours are 0.2 m apart
+  const std::vector<int64_t> kept{map.keyframe(k[3]).id};
+  EXPECT_EQ(map.leastNeededKeyframe(kept), k[4]);  // 0.9 m, before the keyframe at 2 (1.1 m)
+  PlaceMap two(2, 1);
+  chain(two, {0, 5}, {0, 0});
+  EXPECT_EQ(two.leastNeededKeyframe({}), -1);  // a segment's ends always stay
+}
+
+// A turn counts: of keyframes evenly spaced, the one whose neighbours face the same way goes.
+TEST(PlaceMap, TurningMakesAKeyframeNeeded) {
+  PlaceMap map(8, 1);
+  const std::vector<int> k = chain(map, {0, 1, 2, 3, 4}, {0, 0, 0, 90, 90});
+  EXPECT_EQ(map.leastNeededKeyframe({}), k[1]);
 }
 
 }  // namespace

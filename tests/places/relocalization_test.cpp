@@ -8,6 +8,7 @@
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 
+#include "alloc_testing.hpp"
 #include "mcslam/dataset/trajectory.hpp"
 #include "mcslam/eval/trajectory_metrics.hpp"
 #include "test_support.hpp"
@@ -55,6 +56,7 @@ class Relocalization : public ::testing::Test {
     for (std::size_t i = 0; i < r.trajectory.size(); ++i)
       if (static_cast<int>(i) < lost_first || static_cast<int>(i) > lost_last) measured.push_back(r.trajectory[i]);
     r.stats = test::readFile(stats);
+    test::expectRunAllocatedNothing(r.stats);
     const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
     r.ate = computeApe(gt, measured, EvalOptions{}).stats.rmse;
     return r;
@@ -72,6 +74,21 @@ TEST_F(Relocalization, AfterABlackoutOnAStraightTheRigIsFoundInTheSameFrame) {
   const long frame = jsonInt(black.stats, "last_relocalized_frame");
   EXPECT_GE(frame, 80);
   EXPECT_LT(frame, 85);  // within 5 frames of the images' return
+  EXPECT_EQ(jsonInt(black.stats, "segments"), 1);
+  EXPECT_LT(black.ate, 1.5 * plain.ate) << "plain " << plain.ate;
+}
+
+// A place map of 12 keyframes, filled three times over: it stays at its capacity by letting the least needed
+// keyframes go, and the rig is still found after the blackout, in the same frame.
+TEST_F(Relocalization, AFullPlaceMapCullsAndStillRelocalizes) {
+  const Run plain = run("plain", "");
+  const std::string config = test::writeFile(dir_->file("small.yaml"), "slam:\n  places:\n    max_keyframes: 12\n");
+  const Run black = run("small", "--config " + config + " --black 60-79", 60, 79);
+  EXPECT_EQ(jsonInt(black.stats, "place_keyframes"), 12) << black.stats;
+  EXPECT_GT(jsonInt(black.stats, "keyframes_culled"), 20) << black.stats;
+  EXPECT_EQ(jsonInt(black.stats, "keyframes_dropped"), 0) << black.stats;
+  EXPECT_EQ(jsonInt(black.stats, "relocalizations"), 1) << black.stats;
+  EXPECT_LT(jsonInt(black.stats, "last_relocalized_frame"), 85);
   EXPECT_EQ(jsonInt(black.stats, "segments"), 1);
   EXPECT_LT(black.ate, 1.5 * plain.ate) << "plain " << plain.ate;
 }

@@ -302,6 +302,29 @@ TEST_F(DaemonTest, ReplayingPgmFromDiskAllocatesNothingPerFrameAfterWarmup) {
   EXPECT_EQ(s.allocations_after_warmup, 0u) << "over " << s.frames_after_warmup << " frames";
 }
 
+TEST_F(DaemonTest, PlaceMemoryAndMapSavesAllocateNothingPerFrameAfterWarmup) {
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
+  // The rendered route replayed in a loop, tracked (the odometry finds the start again at each wrap): place
+  // keyframes join the map and query it for loops, and the map is saved every 0.2 s, written into the saver's
+  // buffer by the processing thread and to disk by the saver's thread. After warm-up none of these threads
+  // allocates. (Relocalization, culling and loop correction are counted through mcslam-run: tests/places.)
+  const std::string data = test::cachedSimDataset();
+  const DaemonConfig c = config(data,
+                                "    rate: fastest\n    at_end: loop\n    preload: true\nwarmup_frames: 100\n"
+                                "map:\n  save: " +
+                                    dir_.file("robot.map") + "\n  save_interval_s: 0.2\n");
+  Daemon d(c, createPipeline(c.slam, c.file, c.rig));
+  d.start();
+  ASSERT_TRUE(waitFor([&] { return d.stats().processed >= 300; }, 300));
+  d.stop();
+  const DaemonStats s = d.stats();
+  ASSERT_TRUE(s.warm);
+  EXPECT_GT(s.places.keyframes, 3);
+  EXPECT_GE(s.map_saves, 3u);
+  EXPECT_EQ(s.map_save_failures, 0u);
+  EXPECT_EQ(s.allocations_after_warmup, 0u) << "over " << s.frames_after_warmup << " frames";
+}
+
 TEST_F(DaemonTest, SimSourceDeliversTheSimulatorsFramesWholeAndInOrder) {
   // The same simulation as the cached dataset (isec, indoor, ground, 10 Hz, seed 1), two of its cameras
   // in another order: the rendered frames must equal the dataset's images byte for byte.

@@ -4,6 +4,8 @@
 // build a test without the hooks is a mistake in its CMake (ALLOC_HOOKS missing) and fails.
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "mcslam/core/alloc_counter.hpp"
 
 namespace mcslam::test {
@@ -15,6 +17,18 @@ inline bool countsAllocations() {
   if (!alloc::available()) ADD_FAILURE() << "allocation hooks not linked: give the test ALLOC_HOOKS in its CMakeLists";
   return alloc::available();
 #endif
+}
+
+// The stats of a mcslam-run (its --stats JSON): after the warm-up, none of the pipeline's threads allocated.
+// mcslam-run counts when it was built with the hooks, as this test was.
+inline void expectRunAllocatedNothing(const std::string& stats) {
+  if (!countsAllocations()) return;
+  const std::size_t at = stats.find("\"allocations_after_warmup\"");
+  ASSERT_NE(at, std::string::npos) << stats;
+  const std::string part = stats.substr(at, stats.find('}', at) - at);
+  EXPECT_NE(part.find("\"counted\": true"), std::string::npos) << part;
+  for (const char* zero : {"\"front_end_thread\": 0", "\"tracking_thread\": 0", "\"backend_thread\": 0"})
+    EXPECT_NE(part.find(zero), std::string::npos) << part;
 }
 
 }  // namespace mcslam::test

@@ -39,7 +39,8 @@ std::vector<SegmentSummary> segmentsOf(const MapContents& c) {
     out.segment = s;
     out.placed = map.placed(s);
     int32_t root = s;  // union-find parents in the file hang below their segment: this ends
-    while (c.segment_roots[static_cast<std::size_t>(root)] != root) root = c.segment_roots[static_cast<std::size_t>(root)];
+    while (c.segment_roots[static_cast<std::size_t>(root)] != root)
+      root = c.segment_roots[static_cast<std::size_t>(root)];
     out.joined_to = root;
   }
   for (int slot = 0; slot < map.size(); ++slot) {
@@ -137,9 +138,10 @@ void printSummary(const MapSummary& s) {
   }
   std::printf("  extent      keyframes %s\n", extentText(s.keyframe_extent).c_str());
   std::printf("              points    %s (outermost 2%% left out)\n", extentText(s.point_extent).c_str());
-  std::printf("  memory      %.2f MiB to hold it; it needs places.max_keyframes >= %d, max_points_per_keyframe >= %u,"
-              " max_words_per_keyframe >= %u, max_loops >= %d\n",
-              mib(s.memory_bytes), s.keyframes, h.max_points_per_keyframe, s.most_words, s.loops);
+  std::printf(
+      "  memory      %.2f MiB to hold it; it needs places.max_keyframes >= %d, max_points_per_keyframe >= %u,"
+      " max_words_per_keyframe >= %u, max_loops >= %d\n",
+      mib(s.memory_bytes), s.keyframes, h.max_points_per_keyframe, s.most_words, s.loops);
 }
 
 void printSummaryJson(const MapSummary& s) {

@@ -38,8 +38,8 @@ struct MapSummary {
   int loop_groups = 0;      // groups of segments joined by loops (a segment no loop joined is one)
   int loops = 0;
   double path_m = 0;
-  Extent keyframe_extent;  // keyframe positions in the world
-  Extent point_extent;     // points, but for the outermost 2% on each axis
+  Extent keyframe_extent;        // keyframe positions in the world
+  Extent point_extent;           // points, but for the outermost 2% on each axis
   std::size_t memory_bytes = 0;  // place map and database holding exactly this map
 };
 

@@ -4,13 +4,16 @@
 
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <exception>
 #include <future>
 #include <thread>
 
 #include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/synced_file.hpp"
 #include "mcslam/dataset/dataset.hpp"
@@ -203,9 +206,16 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<st
   const std::size_t frames = order.size();
   StageRunner<FrameTag> runner(pipeline);
   FramePrefetch prefetch(ds, order, black);
+  // Frames after the warm-up (the daemon's default) count the pipeline's allocations: none is the rule.
+  constexpr std::size_t kWarmupFrames = 50;
+  run::AllocationCount allocations{alloc::available(), kWarmupFrames};
+  std::atomic<uint64_t> front_end_allocations{0};
+  uint64_t backend_at_warmup = 0;
   auto prepare = [&](std::size_t i) {
     const DatasetFrame f = prefetch.take(i);
+    const alloc::ThreadScope scope;
     runner.prepare(f.view(), FrameTag{f.error()});
+    if (i >= kWarmupFrames) front_end_allocations += scope.count();
   };
   const auto wall_start = std::chrono::steady_clock::now();
   std::exception_ptr front_end_error;
@@ -226,7 +236,10 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<st
     if (!overlap) prepare(i);
     PoseEstimate pose;
     FrameTag tag;
+    if (i == kWarmupFrames) backend_at_warmup = pipeline.backendThreadAllocations();
+    const alloc::ThreadScope scope;
     if (!runner.finish(pose, tag)) break;  // the front-end failed (rethrown below)
+    if (i >= kWarmupFrames) allocations.tracking += scope.count();
     console.frameError(i, tag.error);
     const PipelineTiming& timing = pipeline.timing();
     if (report.add(pose, timing)) console.stateChanged(i, pose, pipeline.cameras());
@@ -247,6 +260,9 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<st
   if (front_end.joinable()) front_end.join();
   if (front_end_error) std::rethrow_exception(front_end_error);
   pipeline.flush();  // the last keyframe's back-end solve
+  if (frames > kWarmupFrames) allocations.backend = pipeline.backendThreadAllocations() - backend_at_warmup;
+  allocations.front_end = front_end_allocations;
+  report.setAllocations(allocations);
   pipeline.keyframes(keyframes);
   report.noteKeyframes(keyframes);
   console.endProgress();
@@ -325,6 +341,11 @@ int main(int argc, char** argv) {
   addOptions(app, options);
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(options.log_level));
+  // What glibc would set up on the first log line, done now: a line logged mid-run (a relocalization) then
+  // allocates nothing.
+  static char log_buffer[BUFSIZ];
+  std::setvbuf(stdout, log_buffer, _IOLBF, sizeof(log_buffer));
+  tzset();
   try {
     return runDataset(options);
   } catch (const InputError& e) {

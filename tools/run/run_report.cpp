@@ -141,6 +141,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("places").beginObject();
     j.key("keyframes").value(p.keyframes);
     j.key("keyframes_dropped").value(p.keyframes_dropped);
+    j.key("keyframes_culled").value(p.keyframes_culled);
     j.key("relocalization_queries").value(p.relocalization_queries);
     j.key("relocalizations").value(p.relocalizations);
     j.key("segments").value(places->map().segments());  // odometry maps started, the first one included
@@ -158,6 +159,13 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("place_keyframes").value(static_cast<long long>(places->map().size()));  // in the map now, loaded included
     j.endObject();
   }
+  j.key("allocations_after_warmup").beginObject();
+  j.key("counted").value(allocations_.counted);
+  j.key("warmup_frames").value(static_cast<unsigned long long>(allocations_.warmup_frames));
+  j.key("front_end_thread").value(static_cast<unsigned long long>(allocations_.front_end));
+  j.key("tracking_thread").value(static_cast<unsigned long long>(allocations_.tracking));
+  j.key("backend_thread").value(static_cast<unsigned long long>(allocations_.backend));
+  j.endObject();
   j.key("timing_ms").beginObject();
   const std::pair<const char*, Summary> stages[] = {{"feature_extraction", summarize(features)},
                                                     {"tracking_and_mapping", summarize(tracking)},

@@ -24,6 +24,14 @@ struct StateChange {
   TrackingState state = TrackingState::NotInitialized;
 };
 
+// Heap allocations after the warm-up, per thread of the pipeline (mcslam-run links the counting hooks; sanitizer
+// builds cannot, and say so with counted = false).
+struct AllocationCount {
+  bool counted = false;
+  uint64_t warmup_frames = 0;
+  uint64_t front_end = 0, tracking = 0, backend = 0;
+};
+
 class RunReport {
  public:
   // Returns true when the frame's tracking state differs from the previous frame's (see stateChanges()).
@@ -41,6 +49,8 @@ class RunReport {
   const std::vector<FrameRecord>& frames() const { return frames_; }
   const std::vector<StateChange>& stateChanges() const { return changes_; }
 
+  void setAllocations(const AllocationCount& a) { allocations_ = a; }
+
   void writeStats(const std::string& path, const SlamPipeline& pipeline, const std::string& dataset, int cameras,
                   double wall_seconds) const;
 
@@ -49,6 +59,7 @@ class RunReport {
   std::map<int64_t, StampedPose> keyframes_;
   std::vector<StateChange> changes_;
   bool last_tracked_unscaled_ = false;
+  AllocationCount allocations_;
 };
 
 }  // namespace mcslam::run

@@ -11,7 +11,9 @@
 #include <string>
 #include <thread>
 
+#include "mcslam/core/synced_file.hpp"
 #include "mcslam/pipeline/frame_processor.hpp"
+#include "realtime/alloc_meter.hpp"
 
 namespace mcslam::platform {
 
@@ -29,15 +31,17 @@ class MapSaver {
   // At a clean stop, with the processing finished: the last map, on disk when it returns; then the thread ends.
   void saveNow(const FrameProcessor& processor);
 
-  const std::string& path() const { return path_; }
+  const std::string& path() const { return target_.path; }
   uint64_t saves() const { return saves_.load(std::memory_order_relaxed); }
   uint64_t failures() const { return failures_.load(std::memory_order_relaxed); }
+  // Of the saver's thread, after its first save (which warms up the file system's paths).
+  uint64_t allocationsSinceWarmup() const { return meter_.since(); }
 
  private:
   void loop();
   bool write();  // the buffer to the file, on the calling thread
 
-  std::string path_;
+  SyncedFileTarget target_;
   int64_t interval_ns_;
   std::string buffer_;
   int64_t last_ns_ = 0;
@@ -47,6 +51,7 @@ class MapSaver {
   std::atomic<bool> busy_{false};        // the buffer belongs to the saver's thread
   std::thread thread_;
   std::atomic<uint64_t> saves_{0}, failures_{0};
+  ThreadAllocMeter meter_;
 };
 
 }  // namespace mcslam::platform

@@ -104,6 +104,10 @@ class SlidingWindowSolver {
   SlidingWindowSolver(const SlidingWindowSolver&) = delete;
   SlidingWindowSolver& operator=(const SlidingWindowSolver&) = delete;
 
+  // Empty again, as constructed (the settings changed since included), without allocating: for a map dropped
+  // after a tracking loss.
+  void clear();
+
   // ---- window contents (ids are the caller's stable ids) ----
   Status addKeyframe(int64_t id, const SE3& T_w_b);
   Status addLandmark(int64_t id, const Vec3& p_w);

@@ -11,4 +11,12 @@ namespace mcslam {
 // content and no "<path>.tmp" is left behind.
 bool writeFileSynced(const std::string& path, std::string_view bytes, std::string* error);
 
+// The names one file's synced writes use, worked out once: writing a file again and again (the daemon's map)
+// then allocates nothing unless a step fails.
+struct SyncedFileTarget {
+  explicit SyncedFileTarget(const std::string& path);
+  std::string path, tmp, folder;
+};
+bool writeFileSynced(const SyncedFileTarget& target, std::string_view bytes, std::string* error);
+
 }  // namespace mcslam

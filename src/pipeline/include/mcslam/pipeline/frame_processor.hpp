@@ -29,7 +29,8 @@ struct PlaceCounters {
   uint64_t loop_closures = 0;
   uint64_t map_merges = 0;
   uint64_t localization_corrections = 0;
-  int64_t keyframes = 0;  // in the place map, a loaded map's included
+  int64_t keyframes = 0;          // in the place map, a loaded map's included
+  uint64_t keyframes_culled = 0;  // let go to make room in the full map
   uint16_t world_revision = 0;
 };
 

@@ -36,6 +36,8 @@ class SlamPipeline final : public FrameProcessor {
   // Completes the back-end work of the last keyframe (finish() does it before the next frame): call it after
   // the last frame, before reading the final keyframes.
   void flush() { odometry_.flush(); }
+  // Heap allocations the back-end's thread has made so far (zero without the counting hooks).
+  uint64_t backendThreadAllocations() const { return odometry_.backendThreadAllocations(); }
 
   // Read on the thread that finishes the frames, between frames.
   const PipelineTiming& timing() const { return timing_; }  // of the last finished frame

@@ -52,6 +52,7 @@ class LoopCloser {
                   const PlaceDatabase& database);
   const LoopStats& stats() const { return stats_; }
   int loops() const { return loop_count_; }
+  std::span<const LoopEdge> loopEdges() const { return {loops_.data(), static_cast<std::size_t>(loop_count_)}; }
   void clear();
   // The segment that stands for all those loops have joined to `segment`.
   int32_t root(int32_t segment) { return findRoot(segment); }

@@ -59,6 +59,11 @@ class PlaceMap {
   bool addPoint(int slot, const PlacePoint& point);  // false when the keyframe holds its maximum
   void finishKeyframe(int slot);
   void eraseKeyframe(int slot);  // its neighbours become each other's
+  // The keyframe a full map can best do without (slot, -1 when none may go): the one whose neighbours in its
+  // segment lie closest together, in translation and in rotation, each measured against the map's typical gap; so
+  // that where the rig lingered or went slowly is thinned first and the path stays covered. A segment's ends stay
+  // (they hold the segment's frame and its joins), and so do the keyframes whose ids are in `kept` (sorted).
+  int leastNeededKeyframe(std::span<const int64_t> kept) const;
 
   const PlaceKeyframe& keyframe(int slot) const { return keyframes_[static_cast<std::size_t>(slot)]; }
   void setKeyframePose(int slot, const SE3& T_w_k) { keyframes_[static_cast<std::size_t>(slot)].T_w_k = T_w_k; }

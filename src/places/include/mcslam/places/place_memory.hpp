@@ -26,7 +26,8 @@ namespace mcslam {
 
 struct PlaceStats {
   uint64_t keyframes = 0;                  // added to the place map
-  uint64_t keyframes_dropped = 0;          // not added: the map was full
+  uint64_t keyframes_dropped = 0;          // not added: the map was full and none could go
+  uint64_t keyframes_culled = 0;           // left the full map to make room (PlaceMap::leastNeededKeyframe)
   uint64_t relocalization_queries = 0;     // lost frames that queried the database
   uint64_t relocalizations = 0;            // ... and were found
   int64_t last_relocalized_keyframe = -1;  // id of the place keyframe the last relocalization verified on
@@ -65,6 +66,7 @@ class PlaceMemory {
  private:
   void followSegment(const Odometry& odometry);
   void addKeyframe(const Odometry& odometry, int odometry_slot);
+  void makeRoom();  // a full map lets its least needed keyframe go, keeping those loops join
   void relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);
   // The tracked frame recognized in the map's other segments places the run in the world, or (localizing in a
   // map) corrects the current segment's T_w_o.
@@ -100,6 +102,7 @@ class PlaceMemory {
   Vec3 last_position_ = Vec3::Zero();
   bool have_last_position_ = false;
   BowVector file_words_;              // scratch of readMap()
+  std::vector<int64_t> kept_ids_;     // scratch of makeRoom(): the loops' keyframes, sorted
   std::vector<uint8_t> root_placed_;  // scratch of propagatePlacement(), per segment
   std::vector<MapFileHeader::Camera> cameras_;
   mutable MapFileHeader file_header_;  // scratch of writeMap(), its cameras sized at construction
