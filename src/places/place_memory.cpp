@@ -162,8 +162,12 @@ void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, O
   ++stats_.relocalizations;
   stats_.last_relocalized_keyframe = map_.keyframe(r.keyframe).id;
   stats_.last_relocalized_frame = static_cast<int64_t>(frame_index);
-  spdlog::info("place memory: frame {} relocalized on place keyframe {} ({} inliers of {} candidates)", frame_index,
-               map_.keyframe(r.keyframe).id, r.inliers, r.candidates);
+  const Vec6 sigma = verifiedPoseSigma(r, options_);
+  spdlog::info(
+      "place memory: frame {} relocalized on place keyframe {} ({} inliers of {} candidates; sigma {:.3f} {:.3f} "
+      "{:.3f} m, {:.2f} {:.2f} {:.2f} deg)",
+      frame_index, map_.keyframe(r.keyframe).id, r.inliers, r.candidates, sigma[0], sigma[1], sigma[2],
+      sigma[3] * 180 / M_PI, sigma[4] * 180 / M_PI, sigma[5] * 180 / M_PI);
   if (!localize_only_)
     for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
 }
