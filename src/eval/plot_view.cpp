@@ -17,7 +17,9 @@ namespace mcslam::plot {
 PlaneView fitPlaneView(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, const cv::Rect& area) {
   PlaneView view;
   view.area = area;
-  const double span_h = std::max(hi.x() - lo.x(), 1e-6), span_v = std::max(hi.y() - lo.y(), 1e-6);
+  // A span under a millionth of the coordinates' size would make grid steps the doubles cannot add.
+  const double floor = std::max(1e-6, 1e-6 * std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff()));
+  const double span_h = std::max(hi.x() - lo.x(), floor), span_v = std::max(hi.y() - lo.y(), floor);
   const double pad = 1.08;  // a margin so that nothing touches the frame
   view.scale = std::min(area.width / (span_h * pad), area.height / (span_v * pad));
   const double mid_h = 0.5 * (lo.x() + hi.x()), mid_v = 0.5 * (lo.y() + hi.y());
@@ -32,13 +34,15 @@ void drawPlaneGrid(cv::Mat& img, const PlaneView& view, const std::string& h_cap
   const double step = niceStep(110.0 / view.scale);
   const int decimals = decimalsFor(step);
   const cv::Rect& a = view.area;
-  for (double w = std::ceil(view.h0 / step) * step; w <= view.h1; w += step) {
+  for (double k = std::ceil(view.h0 / step); k * step <= view.h1; ++k) {
+    const double w = k * step;
     const int x = static_cast<int>(std::lround(a.x + (w - view.h0) * view.scale));
     cv::line(img, {x, a.y}, {x, a.y + a.height}, kGrid, 1);
     cv::line(img, {x, a.y + a.height}, {x, a.y + a.height + 5}, kAxis, 1);
     text(img, formatNumber(w, decimals), x, a.y + a.height + 24, 0.5, kText, 1, Align::Centre);
   }
-  for (double w = std::ceil(view.v0 / step) * step; w <= view.v1; w += step) {
+  for (double k = std::ceil(view.v0 / step); k * step <= view.v1; ++k) {
+    const double w = k * step;
     const int y = static_cast<int>(std::lround(a.y + a.height - (w - view.v0) * view.scale));
     cv::line(img, {a.x, y}, {a.x + a.width, y}, kGrid, 1);
     cv::line(img, {a.x - 5, y}, {a.x, y}, kAxis, 1);

@@ -107,9 +107,11 @@ bool Tracker::coarsePose(const Map& map, const FrameFeatures& frame, uint64_t fr
       found = searchNewestKeyframeByDescriptor(map, frame);
     }
     SE3 candidate = predicted;
+    const int held = matches_.count();  // a keypoint offered several landmarks keeps one: offers overcount
     int n = found >= options_.min_matches_for_pose ? poseFromMatches(map, frame, predicted, true, candidate) : 0;
-    if (n < options_.min_consensus_share * found) n = 0;
-    spdlog::trace("odometry: frame {}: coarse attempt {}: {} matches, {} inliers", frame_index, attempt, found, n);
+    if (n < options_.min_consensus_share * held) n = 0;
+    spdlog::trace("odometry: frame {}: coarse attempt {}: {} matches ({} offered), {} inliers", frame_index, attempt,
+                  held, found, n);
     if (n > inliers) {
       inliers = n;
       coarse = candidate;

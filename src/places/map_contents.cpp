@@ -4,16 +4,29 @@
 
 namespace mcslam {
 
+namespace {
+// Bytes a keyframe, a point and a loop take in the file at the least (PlaceMap::write, LoopCloser::write).
+constexpr uint64_t kMinKeyframeBytes = 8 + 4 + 8 + 8 + 2 * 12 * 8 + 4 + 4 + 4;
+constexpr uint64_t kMinPointBytes = 3 * 4 + 4 + 2 + 1 + 8 + 32;
+constexpr uint64_t kMinLoopBytes = 2 * 8 + 12 * 8 + 6 * 8;
+}  // namespace
+
 MapContents readMapContents(std::string_view bytes, const std::string& name) {
   MapContents c;
   c.file_bytes = bytes.size();
   ByteReader in({}, name);
   c.header = openMapFile(bytes, name, in);
   const MapFileHeader& h = c.header;
-  // The header's counts size the memory; the parts are then checked against them as against capacities.
-  if (h.keyframes > static_cast<uint64_t>(in.remaining()) || h.loops > static_cast<uint64_t>(in.remaining()) ||
-      uint64_t{h.keyframes} * h.max_points_per_keyframe > in.remaining())
-    in.fail("the header counts more keyframes, points or loops than the file can hold");
+  // The header's counts size the memory: each must fit the bytes that follow, at what it takes on disk at least,
+  // so that a forged header cannot ask for much more memory than the file's size. Point slots are kept per
+  // keyframe (keyframes x the fullest one's points): a map of sparse keyframes needs more slots than points, so
+  // that product is bounded by the file's bytes (about 70 per point) or 4 M slots, whichever is more.
+  const uint64_t remaining = in.remaining();
+  const uint64_t slots = uint64_t{h.keyframes} * h.max_points_per_keyframe;
+  const bool counts_fit = h.keyframes <= remaining / kMinKeyframeBytes && h.max_points_per_keyframe <= h.points &&
+                          h.points <= remaining / kMinPointBytes && slots <= std::max<uint64_t>(remaining, 1u << 22) &&
+                          h.loops <= remaining / kMinLoopBytes;
+  if (!counts_fit) in.fail("the header counts more keyframes, points or loops than the file can hold");
   c.map = std::make_unique<PlaceMap>(static_cast<int>(h.keyframes), static_cast<int>(h.max_points_per_keyframe));
   c.map->read(in, static_cast<int>(h.cameras.size()));
   BowVector words(static_cast<int>(std::min<uint64_t>(h.vocabulary_words, in.remaining() / 8)));

@@ -315,7 +315,7 @@ TEST_F(DaemonTest, PlaceMemoryAndMapSavesAllocateNothingPerFrameAfterWarmup) {
                                     dir_.file("robot.map") + "\n  save_interval_s: 0.2\n");
   Daemon d(c, createPipeline(c.slam, c.file, c.rig));
   d.start();
-  ASSERT_TRUE(waitFor([&] { return d.stats().processed >= 300; }, 300));
+  ASSERT_TRUE(waitFor([&] { return d.stats().processed >= 300 && d.stats().map_saves >= 3; }, 300));
   d.stop();
   const DaemonStats s = d.stats();
   ASSERT_TRUE(s.warm);

@@ -46,7 +46,7 @@ TopView topViewOf(const PlaceMap& map) {
   const Vec3 spread = eigen.eigenvalues().cwiseMax(0).cwiseSqrt();  // increasing
   Vec3 main = eigen.eigenvectors().col(2);
   if (map.size() > 1 && main.dot(map.keyframe(map.size() - 1).T_w_k.t - map.keyframe(0).T_w_k.t) < 0) main = -main;
-  const bool planar = spread[1] >= kLineShare * spread[2] && spread[0] <= kPlaneShare * spread[1];
+  const bool planar = spread[2] > 0 && spread[1] >= kLineShare * spread[2] && spread[0] <= kPlaneShare * spread[1];
   if (!planar) return viewWithUp(-down, main, "top view: up is against the first keyframe's y axis");
   const Vec3 normal = eigen.eigenvectors().col(0);
   return viewWithUp(normal.dot(down) > 0 ? -normal : normal, main, "top view: the plane of the keyframes' motion");

@@ -1,6 +1,7 @@
 // mcslam-map: what a saved map holds (`info`), and its top view (`info --plot`).
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <exception>
 
 #include "map_summary.hpp"
 #include "map_top_view.hpp"
@@ -43,6 +44,9 @@ int main(int argc, char** argv) {
     }
   } catch (const InputError& err) {
     std::fprintf(stderr, "mcslam-map: %s\n", err.what());
+    return 2;
+  } catch (const std::exception& err) {  // e.g. a map too large for this computer's memory
+    std::fprintf(stderr, "mcslam-map: %s: %s\n", path.c_str(), err.what());
     return 2;
   }
   return 0;
