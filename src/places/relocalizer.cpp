@@ -33,6 +33,9 @@ namespace {
 
 // A RANSAC consensus only proposes a pose: the guided search and min_inliers decide.
 constexpr int kRansacMinInliers = 12;
+// ... and a consensus of under a fifth of the putative matches is not even a proposal: chance agreement among
+// descriptor matches (wrong places gave 3-11% on the kidnapped routes, right ones 28-91%: BENCHMARKS.md, "Kidnap").
+constexpr double kRansacMinShare = 0.2;
 constexpr int kGridCell = 32;
 constexpr double kSearchRadiusPx = 8.0;  // at octave 0, around the projection (ORB-SLAM's relocalization: 10)
 
@@ -199,7 +202,7 @@ bool Relocalizer::verify(const FrameFeatures& frame, const FrameWords& words, co
   if (matched < kRansacMinInliers) return false;
   const AbsolutePoseRansacResult r =
       ransac_.estimate(std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(matched)));
-  if (!r.ok()) return false;
+  if (!r.ok() || r.num_inliers < kRansacMinShare * matched) return false;
   // The consensus may be repeated texture: the pose must find its points where they project.
   const int projected = searchByProjection(frame, map, r.T_w_b);
   const PoseRefinementResult refined = refiner_.refine(

@@ -137,7 +137,8 @@ bool trackedAt(const std::string& stats, double t) {
 
 // A kidnap: 2.4 m out, the rig is carried to the way back, 1.3 m from the start and facing it (18 s of frames
 // skipped). The odometry must not take the new view for its old map (a consensus of chance matches): it loses
-// track, and place memory finds the rig again in the same world frame: standing at the start at the end, facing as
+// track (facing away from what it mapped, past relocalization_timeout_s: a new odometry map starts), and place
+// memory finds the rig again in the same world frame once it sees the start: standing there at the end, facing as
 // at first, its published pose is the first one's.
 TEST_F(LoopClosure, AKidnappedRigIsNotTrackedFalselyAndIsFoundAgain) {
   const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
@@ -145,10 +146,24 @@ TEST_F(LoopClosure, AKidnappedRigIsNotTrackedFalselyAndIsFoundAgain) {
   const Trajectory published = readTumTrajectory(dir_->file("kidnap.tum"));
   const double kidnap_t = toSeconds(gt[220].t);                           // the first frame after the skipped ones
   EXPECT_FALSE(trackedAt(kidnapped.stats, kidnap_t)) << kidnapped.stats;  // not taken for the old place
-  EXPECT_GE(jsonInt(kidnapped.stats, "relocalizations"), 1) << kidnapped.stats;
-  EXPECT_EQ(jsonInt(kidnapped.stats, "segments"), 1) << kidnapped.stats;
+  // Once, and right: a relocalization on a chance consensus (during the final turn) would come first.
+  EXPECT_EQ(jsonInt(kidnapped.stats, "relocalizations"), 1) << kidnapped.stats;
   ASSERT_FALSE(published.empty());
   EXPECT_TRUE(trackedAt(kidnapped.stats, toSeconds(published.back().t))) << kidnapped.stats;
+  // Before the kidnap and from the relocalization on, the poses are the truth's (related by the first pose) to
+  // decimetres. (In between, past relocalization_timeout_s, a new odometry map goes on from where the motion model
+  // left the rig: off by the kidnap until it is recognized.)
+  const SE3 gt_from_world = nearest(gt, toSeconds(published.front().t)) * published.front().T_w_b.inverse();
+  const double found_t = toSeconds(gt[static_cast<std::size_t>(jsonInt(kidnapped.stats, "last_relocalized_frame"))].t);
+  int checked = 0;
+  for (const StampedPose& p : published) {
+    const double t = toSeconds(p.t);
+    if (!trackedAt(kidnapped.stats, t) || (t > kidnap_t - 1e-6 && t < found_t - 1e-6)) continue;
+    const Vec3 error = (gt_from_world * p.T_w_b).t - nearest(gt, toSeconds(p.t)).t;
+    EXPECT_LT(error.norm(), 0.3) << "t = " << toSeconds(p.t);
+    ++checked;
+  }
+  EXPECT_GT(checked, 55);
   const SE3 drift = published.front().T_w_b.inverse() * published.back().T_w_b;
   std::printf("kidnap: back at the start, %.3f m and %.2f deg from the first pose\n", drift.t.norm(),
               so3Log(drift.R).norm() * 180 / M_PI);
