@@ -34,7 +34,7 @@ namespace {
 // A RANSAC consensus only proposes a pose: the guided search and min_inliers decide.
 constexpr int kRansacMinInliers = 12;
 // ... and a consensus of under a fifth of the putative matches is not even a proposal: chance agreement among
-// descriptor matches (wrong places gave 3-11% on the kidnapped routes, right ones 28-91%: BENCHMARKS.md, "Kidnap").
+// descriptor matches (BENCHMARKS.md, "Kidnap").
 constexpr double kRansacMinShare = 0.2;
 constexpr int kGridCell = 32;
 constexpr double kSearchRadiusPx = 8.0;  // at octave 0, around the projection (ORB-SLAM's relocalization: 10)
