@@ -161,9 +161,9 @@ int LoopCloser::slotOfId(const PlaceMap& map, int64_t id) const {
   return -1;
 }
 
-// Nodes: every place keyframe, in slot order. Edges: consecutive keyframes of a segment (the odometry's relative
-// pose), and the loops. Each set of segments joined by loops is held by the oldest keyframe of its root segment.
 constexpr std::size_t kLoopBytes = 2 * sizeof(int64_t) + 12 * sizeof(double) + 6 * sizeof(double);
+
+std::size_t loopFileBytes() { return kLoopBytes; }
 
 std::size_t LoopCloser::maxWrittenBytes() const {
   return sizeof(uint32_t) + loops_.size() * kLoopBytes + PlaceMap::kMaxSegments * sizeof(int32_t);
@@ -211,6 +211,8 @@ void LoopCloser::read(ByteReader& in, int segments) {
   loop_count_ = takeLoops(in, segments, loops_, segment_root_);
 }
 
+// Nodes: every place keyframe, in slot order. Edges: consecutive keyframes of a segment (the odometry's relative
+// pose), and the loops. Each set of segments joined by loops is held by the oldest keyframe of its root segment.
 void LoopCloser::buildGraph(const PlaceMap& map) {
   graph_.clear();
   std::fill(node_of_slot_.begin(), node_of_slot_.end(), -1);

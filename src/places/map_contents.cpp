@@ -4,13 +4,6 @@
 
 namespace mcslam {
 
-namespace {
-// Bytes a keyframe, a point and a loop take in the file at the least (PlaceMap::write, LoopCloser::write).
-constexpr uint64_t kMinKeyframeBytes = 8 + 4 + 8 + 8 + 2 * 12 * 8 + 4 + 4 + 4;
-constexpr uint64_t kMinPointBytes = 3 * 4 + 4 + 2 + 1 + 8 + 32;
-constexpr uint64_t kMinLoopBytes = 2 * 8 + 12 * 8 + 6 * 8;
-}  // namespace
-
 MapContents readMapContents(std::string_view bytes, const std::string& name) {
   MapContents c;
   c.file_bytes = bytes.size();
@@ -23,13 +16,13 @@ MapContents readMapContents(std::string_view bytes, const std::string& name) {
   // that product is bounded by the file's bytes (about 70 per point) or 4 M slots, whichever is more.
   const uint64_t remaining = in.remaining();
   const uint64_t slots = uint64_t{h.keyframes} * h.max_points_per_keyframe;
-  const bool counts_fit = h.keyframes <= remaining / kMinKeyframeBytes && h.max_points_per_keyframe <= h.points &&
-                          h.points <= remaining / kMinPointBytes && slots <= std::max<uint64_t>(remaining, 1u << 22) &&
-                          h.loops <= remaining / kMinLoopBytes;
+  const bool counts_fit = h.keyframes <= remaining / PlaceMap::keyframeFileBytes() &&
+                          h.max_points_per_keyframe <= h.points && h.points <= remaining / PlaceMap::pointFileBytes() &&
+                          slots <= std::max<uint64_t>(remaining, 1u << 22) && h.loops <= remaining / loopFileBytes();
   if (!counts_fit) in.fail("the header counts more keyframes, points or loops than the file can hold");
   c.map = std::make_unique<PlaceMap>(static_cast<int>(h.keyframes), static_cast<int>(h.max_points_per_keyframe));
   c.map->read(in, static_cast<int>(h.cameras.size()));
-  BowVector words(static_cast<int>(std::min<uint64_t>(h.vocabulary_words, in.remaining() / 8)));
+  BowVector words(static_cast<int>(std::min<uint64_t>(h.vocabulary_words, in.remaining() / kWordFileBytes)));
   for (int slot = 0; slot < c.map->size(); ++slot) {
     takeKeyframeWords(in, static_cast<int>(h.vocabulary_words), c.map->keyframe(slot).id, "the vocabulary's words",
                       words);

@@ -85,6 +85,8 @@ MapFileHeader openMapFile(std::string_view bytes, const std::string& name, ByteR
   return h;
 }
 
+std::size_t keyframeWordsBytes(std::size_t words) { return sizeof(uint32_t) + words * kWordFileBytes; }
+
 void putKeyframeWords(ByteWriter& out, std::span<const BowEntry> entries) {
   out.put<uint32_t>(static_cast<uint32_t>(entries.size()));
   for (const BowEntry& e : entries) {

@@ -158,6 +158,9 @@ constexpr std::size_t kKeyframeBytes = sizeof(int64_t) + sizeof(int32_t) + sizeo
 
 }  // namespace
 
+std::size_t PlaceMap::keyframeFileBytes() { return kKeyframeBytes; }
+std::size_t PlaceMap::pointFileBytes() { return kPointBytes; }
+
 std::size_t PlaceMap::maxWrittenBytes() const {
   return sizeof(int64_t) + sizeof(uint32_t) + kMaxSegments * (kPoseBytes + 1) + sizeof(uint32_t) +
          static_cast<std::size_t>(capacity()) * (kKeyframeBytes + static_cast<std::size_t>(max_points_) * kPointBytes);

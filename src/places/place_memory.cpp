@@ -267,7 +267,7 @@ void PlaceMemory::propagatePlacement() {
 std::size_t PlaceMemory::maxMapBytes() const {
   return mapEnvelopeBytes() + mapHeaderBytes(static_cast<int>(cameras_.size())) + map_.maxWrittenBytes() +
          static_cast<std::size_t>(map_.capacity()) *
-             (sizeof(uint32_t) + static_cast<std::size_t>(database_.maxWordsPerPlace()) * 2 * sizeof(uint32_t)) +
+             keyframeWordsBytes(static_cast<std::size_t>(database_.maxWordsPerPlace())) +
          loop_closer_.maxWrittenBytes();
 }
 

@@ -40,6 +40,7 @@ struct LoopEdge {
 // loop count; InputError from `in` for more loops than `loops` holds or a root that is no union.
 void putLoops(ByteWriter& out, std::span<const LoopEdge> loops, std::span<const int32_t> roots);
 int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span<int32_t> roots);
+std::size_t loopFileBytes();  // one loop in putLoops' output
 
 class LoopCloser {
  public:

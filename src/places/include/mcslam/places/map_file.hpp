@@ -49,6 +49,8 @@ MapFileHeader openMapFile(std::string_view bytes, const std::string& name, ByteR
 
 // One keyframe's words in the payload: u32 count, then u32 word and f32 weight each, words increasing.
 void putKeyframeWords(ByteWriter& out, std::span<const BowEntry> entries);
+inline constexpr std::size_t kWordFileBytes = sizeof(int32_t) + sizeof(float);  // one word and its weight
+std::size_t keyframeWordsBytes(std::size_t words);  // what putKeyframeWords writes for that many
 // Reads them into `out` (its capacity bounds the count: `capacity_setting` names where it comes from). InputError
 // from `in` naming keyframe `keyframe_id` for a word outside `vocabulary_words`, out of order or weighted wrongly.
 void takeKeyframeWords(ByteReader& in, int vocabulary_words, int64_t keyframe_id, const char* capacity_setting,

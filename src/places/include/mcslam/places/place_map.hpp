@@ -95,8 +95,11 @@ class PlaceMap {
   // or whose points name a camera beyond `cameras`, is refused (InputError from `in`).
   void write(ByteWriter& out) const;
   void read(ByteReader& in, int cameras);
-  // Bytes write() needs at most for this map's capacities.
+  // Bytes write() needs at most for this map's capacities; bytes one keyframe (without its points) and one point
+  // take in it.
   std::size_t maxWrittenBytes() const;
+  static std::size_t keyframeFileBytes();
+  static std::size_t pointFileBytes();
   int64_t nextId() const { return next_id_; }
 
  private:
