@@ -29,4 +29,13 @@ ErrorStats computeErrorStats(const std::vector<double>& errors) {
   return s;
 }
 
+std::pair<double, double> centralRange(std::vector<double> values, double share) {
+  const auto at = [&](double q) {
+    const auto k = static_cast<std::size_t>(std::lround(q * static_cast<double>(values.size() - 1)));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+    return values[k];
+  };
+  return {at(share), at(1 - share)};
+}
+
 }  // namespace mcslam

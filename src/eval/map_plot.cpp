@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "mcslam/core/error.hpp"
+#include "mcslam/eval/error_stats.hpp"
 #include "plot_drawing.hpp"
 #include "plot_view.hpp"
 
@@ -31,16 +32,6 @@ cv::Scalar pathColour(std::size_t i) {
   return {static_cast<double>(c[0]), static_cast<double>(c[1]), static_cast<double>(c[2])};
 }
 
-// Bounds of a coordinate that leave out `share` of the values at each end: a few far points do not shrink the map.
-std::pair<double, double> robustRange(std::vector<double> v, double share) {
-  const auto at = [&](double q) {
-    const auto k = static_cast<std::size_t>(std::lround(q * static_cast<double>(v.size() - 1)));
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-    return v[k];
-  };
-  return {at(share), at(1 - share)};
-}
-
 // The box shown: every keyframe, and the points but their outermost 2% on each axis.
 plot::PlaneView viewOf(const MapPlot& plot, const cv::Rect& area) {
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -55,7 +46,7 @@ plot::PlaneView viewOf(const MapPlot& plot, const cv::Rect& area) {
       std::vector<double> v;
       v.reserve(plot.points.size());
       for (const Eigen::Vector2d& p : plot.points) v.push_back(p[axis]);
-      const auto [a, b] = robustRange(std::move(v), 0.02);
+      const auto [a, b] = centralRange(std::move(v), 0.02);
       lo[axis] = std::min(lo[axis], a);
       hi[axis] = std::max(hi[axis], b);
     }

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <tuple>
 
 #include "mcslam/core/json_writer.hpp"
+#include "mcslam/eval/error_stats.hpp"
 #include "mcslam/recognition/bow_vector.hpp"
 
 namespace mcslam::map_tool {
@@ -20,13 +22,7 @@ Extent robustExtent(std::vector<Vec3> points, double share) {
     std::vector<double> v;
     v.reserve(points.size());
     for (const Vec3& p : points) v.push_back(p[axis]);
-    const auto at = [&](double q) {
-      const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-      return v[k];
-    };
-    e.lo[axis] = at(share);
-    e.hi[axis] = at(1 - share);
+    std::tie(e.lo[axis], e.hi[axis]) = centralRange(std::move(v), share);
   }
   return e;
 }
