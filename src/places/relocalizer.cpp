@@ -38,6 +38,11 @@ constexpr int kRansacMinInliers = 12;
 constexpr double kRansacMinShare = 0.2;
 constexpr int kGridCell = 32;
 constexpr double kSearchRadiusPx = 8.0;  // at octave 0, around the projection (ORB-SLAM's relocalization: 10)
+// A consensus of distant points alone (a far wall) trades a few degrees of pitch or yaw for metres of translation
+// almost freely; nearer points then project tens of pixels from their keypoints, and a narrow search there finds
+// texture that confirms the wrong pose. So the first guided pass searches this wide and keeps only distinctive
+// matches (ratio test): a pose refined on them is close enough for the narrow pass.
+constexpr double kWideSearchRadiusPx = 4 * kSearchRadiusPx;
 
 AbsolutePoseRansacOptions ransacOptions() {
   AbsolutePoseRansacOptions r;
@@ -75,7 +80,8 @@ void Relocalizer::prepareFrame(const FrameFeatures& frame) {
       grids_[static_cast<std::size_t>(c)].build(frame.sets[static_cast<std::size_t>(c)]);
 }
 
-int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& map, const SE3& T_w_b) {
+int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& map, const SE3& T_w_b, double radius_px,
+                                    float ratio) {
   const int cams = frame.cameras();
   for (int c = 0; c < cams; ++c)
     std::fill_n(best_point_[static_cast<std::size_t>(c)].begin(), frame.sets[static_cast<std::size_t>(c)].count,
@@ -88,6 +94,13 @@ int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& 
     auto& best_distance = best_distance_[static_cast<std::size_t>(c)];
     auto& best_point = best_point_[static_cast<std::size_t>(c)];
     auto& best_keyframe = best_keyframe_[static_cast<std::size_t>(c)];
+    const auto offer = [&](int index, int distance, const PlacePoint& p, int kf) {
+      const auto k = static_cast<std::size_t>(index);
+      if (distance > options_.max_hamming || (best_point[k] && distance >= best_distance[k])) return;
+      best_point[k] = &p;
+      best_distance[k] = distance;
+      best_keyframe[k] = kf;
+    };
     for (int g = 0; g < group_count_; ++g) {
       const int kf = group_[static_cast<std::size_t>(g)];
       const SE3 T_c_k = T_c_w * map.keyframe(kf).T_w_k;
@@ -95,18 +108,22 @@ int Relocalizer::searchByProjection(const FrameFeatures& frame, const PlaceMap& 
         const Vec3 p_c = T_c_k * p.p_k.cast<double>();
         Vec2 uv;
         if (p_c.z() <= 0 || !model.project(p_c, uv) || !model.inImage(uv, 0)) continue;
-        const double radius = kSearchRadiusPx * octave_sigma_[p.octave];
+        const double radius = radius_px * octave_sigma_[p.octave];
+        int first = INT_MAX, second = INT_MAX, first_index = -1;
         grids_[static_cast<std::size_t>(c)].forEachNear(uv.x(), uv.y(), radius, [&](const KeypointGrid::Entry& e) {
           if ((Vec2(e.x, e.y) - uv).squaredNorm() > radius * radius) return;
           const int d = hammingDistance(p.descriptor, set.descriptors[static_cast<std::size_t>(e.index)]);
-          if (d > options_.max_hamming) return;
-          const auto k = static_cast<std::size_t>(e.index);
-          if (!best_point[k] || d < best_distance[k]) {
-            best_point[k] = &p;
-            best_distance[k] = d;
-            best_keyframe[k] = kf;
+          if (ratio <= 0) {
+            offer(e.index, d, p, kf);
+          } else if (d < first) {
+            second = first;
+            first = d;
+            first_index = e.index;
+          } else if (d < second) {
+            second = d;
           }
         });
+        if (first_index >= 0 && passesRatioTest(first, second, ratio)) offer(first_index, first, p, kf);
       }
     }
   }
@@ -195,6 +212,26 @@ int Relocalizer::match(const FrameFeatures& frame, const FrameWords& words, cons
   return count;
 }
 
+PoseRefinementResult Relocalizer::poseByProjection(const FrameFeatures& frame, const PlaceMap& map, int keyframe,
+                                                   const SE3& hypothesis) {
+  prepareFrame(frame);
+  gatherGroup(map, keyframe);
+  int projected = 0;
+  return refineByProjection(frame, map, hypothesis, projected);
+}
+
+PoseRefinementResult Relocalizer::refineByProjection(const FrameFeatures& frame, const PlaceMap& map,
+                                                     const SE3& hypothesis, int& projected) {
+  SE3 start = hypothesis;
+  const int distinctive = searchByProjection(frame, map, hypothesis, kWideSearchRadiusPx, options_.match_ratio);
+  const PoseRefinementResult coarse = refiner_.refine(
+      std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(distinctive)), hypothesis);
+  if (coarse.success && coarse.num_inliers >= kRansacMinInliers) start = coarse.T_w_b;
+  projected = searchByProjection(frame, map, start, kSearchRadiusPx, 0.0f);
+  return refiner_.refine(std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(projected)),
+                         start);
+}
+
 bool Relocalizer::verify(const FrameFeatures& frame, const FrameWords& words, const PlaceMap& map, int keyframe,
                          RelocalizationResult& result) {
   gatherGroup(map, keyframe);
@@ -204,9 +241,8 @@ bool Relocalizer::verify(const FrameFeatures& frame, const FrameWords& words, co
       ransac_.estimate(std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(matched)));
   if (!r.ok() || r.num_inliers < kRansacMinShare * matched) return false;
   // The consensus may be repeated texture: the pose must find its points where they project.
-  const int projected = searchByProjection(frame, map, r.T_w_b);
-  const PoseRefinementResult refined = refiner_.refine(
-      std::span<const PoseObservation>(observations_.data(), static_cast<std::size_t>(projected)), r.T_w_b);
+  int projected = 0;
+  const PoseRefinementResult refined = refineByProjection(frame, map, r.T_w_b, projected);
   spdlog::debug("relocalizer: keyframe {} (group {}): {} matches, {} RANSAC inliers, {} by projection, {} inliers",
                 map.keyframe(keyframe).id, group_count_, matched, r.num_inliers, projected, refined.num_inliers);
   // A right pose explains most of what it projects onto similar keypoints, and a good part of the frame; a pose

@@ -3,7 +3,8 @@
 // neighbours in its segment, whose points overlap it) is verified by matching the frame's keypoints, of every
 // camera, to its points within the same vocabulary node (Hamming distance, ratio test across distinct landmarks),
 // generalized P3P in RANSAC over the rig's rays, then a guided search (every point of the group projected into
-// every camera at that pose, matched within a radius) and refinement on all of it. The first candidate that passes
+// every camera at that pose, matched within a radius: a wide pass for distinctive matches, then a narrow one at the
+// pose they give) and refinement on all of it. The first candidate that passes
 // the acceptance rule after the guided search gives the frame's world pose: repeated texture can make a wrong
 // RANSAC consensus, which the guided search does not confirm (docs/design/places.md).
 // Fixed memory: every buffer is sized at construction.
@@ -86,6 +87,11 @@ class Relocalizer {
     return result;
   }
 
+  // The guided stage of verification alone: the pose of `frame` from the points of `keyframe` and its neighbours,
+  // starting at `hypothesis` (a RANSAC consensus).
+  PoseRefinementResult poseByProjection(const FrameFeatures& frame, const PlaceMap& map, int keyframe,
+                                        const SE3& hypothesis);
+
   // The inlier matches of the last successful locate().
   std::span<const PlaceMatch> inliers() const { return {inliers_.data(), static_cast<std::size_t>(inlier_count_)}; }
 
@@ -93,9 +99,16 @@ class Relocalizer {
   bool verify(const FrameFeatures& frame, const FrameWords& words, const PlaceMap& map, int keyframe,
               RelocalizationResult& result);
   void prepareFrame(const FrameFeatures& frame);  // the keypoint grids of the guided search
-  // Every point of the group projected at T_w_b into every camera, matched to the nearest similar keypoint; fills
-  // matches_ and observations_ anew; returns how many.
-  int searchByProjection(const FrameFeatures& frame, const PlaceMap& map, const SE3& T_w_b);
+  // Two guided passes from `hypothesis` over the group's points: wide and distinctive, then narrow at the pose
+  // refined on the first; `projected` = the narrow pass's matches, in matches_ and observations_.
+  PoseRefinementResult refineByProjection(const FrameFeatures& frame, const PlaceMap& map, const SE3& hypothesis,
+                                          int& projected);
+  // Every point of the group projected at T_w_b into every camera and matched within radius_px (at octave 0) to a
+  // similar keypoint: with ratio > 0 only to its most similar one, when that passes the ratio test against the next;
+  // with ratio 0 to each, every keypoint keeping its most similar point. Fills matches_ and observations_ anew;
+  // returns how many.
+  int searchByProjection(const FrameFeatures& frame, const PlaceMap& map, const SE3& T_w_b, double radius_px,
+                         float ratio);
   // Matches the frame's keypoints to the points of the keyframes in group_; fills matches_ and observations_.
   int match(const FrameFeatures& frame, const FrameWords& words, const PlaceMap& map);
   int gatherGroup(const PlaceMap& map, int keyframe);
