@@ -1,18 +1,15 @@
 #!/usr/bin/env bash
 # Sets up (packages + build) and runs the whole test suite through CTest.
 # Usage: tools/run-tests.sh [--ci]
-#   --ci   what CI runs (.ci/run): the build with -Werror, the suite, the formatter check (tools/check-format.sh),
-#          the sanitizer jobs (tools/run-sanitizers.sh: ASan+UBSan over the suite, TSan over the threaded tests) and
-#          the arm64 job: the cross build of the arm64-ci suites only (tools/build-arm64.sh arm64-ci, with -Werror)
-#          and those suites under qemu-user (tools/test-arm64.sh --subset); the whole suite under qemu is too slow
-#          for CI (docs/arm64.md)
+#   --ci   what CI runs (.ci/run): the build with -Werror, the suite, the formatter check (tools/check-format.sh)
+#          and the sanitizer jobs (tools/run-sanitizers.sh: ASan+UBSan over the suite, TSan over the threaded tests)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ci=0
 case "${1:-}" in
   "") ;;
   --ci) ci=1 ;;
-  -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,5p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   *) echo "run-tests: unknown option '$1' (see --help)" >&2; exit 2 ;;
 esac
 
@@ -25,6 +22,4 @@ fi
 ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
 if ((ci)); then
   tools/run-sanitizers.sh all
-  MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" tools/build-arm64.sh arm64-ci
-  tools/test-arm64.sh --subset
 fi
