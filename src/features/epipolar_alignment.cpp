@@ -6,6 +6,10 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#define MCSLAM_ALIGN_HAVE_SSE2 1
+#elif defined(__ARM_NEON) && defined(__aarch64__)
+#include <arm_neon.h>
+#define MCSLAM_ALIGN_HAVE_NEON 1
 #endif
 
 namespace mcslam {
@@ -22,25 +26,65 @@ bool inside(const ImageView& im, double x, double y, double ex, double ey) {
 }
 
 // Bilinear samples at count positions (a multiple of 4), written to out; the caller has checked that every
-// (x, y) and (x + 1, y + 1) is inside. Four at a time: the pixel pairs of both rows are read as one 32-bit word
-// per sample and split into lanes, so the loads, not the arithmetic, are the per-sample work (a frame aligns
-// thousands of partners, each in a few iterations of 49 samples).
-void sampleBilinear(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
+// (x, y) and (x + 1, y + 1) is inside. The portable reference; the vector kernels below compute the same lanes
+// with the same operations in the same order, so all give identical floats.
+void sampleBilinearPortable(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
+  for (int k = 0; k < count; ++k) {
+    const int x0 = static_cast<int>(xs[k]), y0 = static_cast<int>(ys[k]);  // positions are >= 0: truncation floors
+    const float ax = xs[k] - static_cast<float>(x0), ay = ys[k] - static_cast<float>(y0);
+    const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(y0) * im.stride + x0;
+    const float p00 = p[0], p10 = p[1], p01 = p[im.stride], p11 = p[im.stride + 1];
+    const float top = p00 + ax * (p10 - p00), bottom = p01 + ax * (p11 - p01);
+    out[k] = top + ay * (bottom - top);
+  }
+}
+
+// Sums of products over padded arrays, in 4 lanes added in a fixed order (the result does not depend on the
+// thread, the call site or the kernel).
+struct Sums {
+  double s[3];
+};
+double total4(const float* l) { return (static_cast<double>(l[0]) + l[1]) + (static_cast<double>(l[2]) + l[3]); }
+Sums dot3Portable(const float* d, const float* a, const float* b, int padded) {
+  float l0[4] = {}, l1[4] = {}, l2[4] = {};
+  for (int g = 0; g < padded; g += 4) {
+    for (int k = 0; k < 4; ++k) {
+      const float v = d[g + k];
+      l0[k] += v * v;
+      l1[k] += v * a[g + k];
+      l2[k] += v * b[g + k];
+    }
+  }
+  return {{total4(l0), total4(l1), total4(l2)}};
+}
+double sumPortable(const float* v, int padded) {
+  float l[4] = {};
+  for (int g = 0; g < padded; g += 4) {
+    for (int k = 0; k < 4; ++k) l[k] += v[g + k];
+  }
+  return total4(l);
+}
+
+// The pixel pairs of both rows of sample k as one 32-bit word (top pair low): the loads, not the arithmetic,
+// are the per-sample work (a frame aligns thousands of partners, each in a few iterations of 49 samples).
+inline uint32_t pixelWord(const ImageView& im, int32_t x, int32_t y) {
+  const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(y) * im.stride + x;
+  uint16_t top, bottom;
+  std::memcpy(&top, p, 2);
+  std::memcpy(&bottom, p + im.stride, 2);
+  return static_cast<uint32_t>(top) | (static_cast<uint32_t>(bottom) << 16);
+}
+
+#if defined(MCSLAM_ALIGN_HAVE_SSE2)
+void sampleBilinearSimd(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
   for (int g = 0; g < count; g += 4) {
-#if defined(__SSE2__)
     const __m128 x = _mm_loadu_ps(xs + g), y = _mm_loadu_ps(ys + g);
-    const __m128i xi = _mm_cvttps_epi32(x), yi = _mm_cvttps_epi32(y);  // positions are >= 0: truncation floors
+    const __m128i xi = _mm_cvttps_epi32(x), yi = _mm_cvttps_epi32(y);
     const __m128 ax = _mm_sub_ps(x, _mm_cvtepi32_ps(xi)), ay = _mm_sub_ps(y, _mm_cvtepi32_ps(yi));
     alignas(16) int32_t xk[4], yk[4];
     _mm_store_si128(reinterpret_cast<__m128i*>(xk), xi);
     _mm_store_si128(reinterpret_cast<__m128i*>(yk), yi);
-    auto word = [&](int k) {
-      const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(yk[k]) * im.stride + xk[k];
-      uint16_t top, bottom;
-      std::memcpy(&top, p, 2);
-      std::memcpy(&bottom, p + im.stride, 2);
-      return static_cast<int>(static_cast<uint32_t>(top) | (static_cast<uint32_t>(bottom) << 16));
-    };
+    auto word = [&](int k) { return static_cast<int>(pixelWord(im, xk[k], yk[k])); };
     // Built in registers: four 32-bit stores read back as one 128-bit load would stall store forwarding.
     const __m128i w = _mm_set_epi32(word(3), word(2), word(1), word(0));
     const __m128i byte = _mm_set1_epi32(0xFF);
@@ -51,31 +95,14 @@ void sampleBilinear(const ImageView& im, const float* xs, const float* ys, int c
     const __m128 top = _mm_add_ps(p00, _mm_mul_ps(ax, _mm_sub_ps(p10, p00)));
     const __m128 bottom = _mm_add_ps(p01, _mm_mul_ps(ax, _mm_sub_ps(p11, p01)));
     _mm_storeu_ps(out + g, _mm_add_ps(top, _mm_mul_ps(ay, _mm_sub_ps(bottom, top))));
-#else
-    for (int k = g; k < g + 4; ++k) {
-      const int x0 = static_cast<int>(xs[k]), y0 = static_cast<int>(ys[k]);
-      const float ax = xs[k] - static_cast<float>(x0), ay = ys[k] - static_cast<float>(y0);
-      const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(y0) * im.stride + x0;
-      const float p00 = p[0], p10 = p[1], p01 = p[im.stride], p11 = p[im.stride + 1];
-      const float top = p00 + ax * (p10 - p00), bottom = p01 + ax * (p11 - p01);
-      out[k] = top + ay * (bottom - top);
-    }
-#endif
   }
 }
-
-// Sums of products over padded arrays, in 4 lanes added in a fixed order (the result does not depend on the
-// thread or the call site).
-struct Sums {
-  double s[3];
-};
-#if defined(__SSE2__)
 double total(__m128 l) {
   alignas(16) float v[4];
   _mm_store_ps(v, l);
-  return (static_cast<double>(v[0]) + v[1]) + (static_cast<double>(v[2]) + v[3]);
+  return total4(v);
 }
-Sums dot3(const float* d, const float* a, const float* b, int padded) {
+Sums dot3Simd(const float* d, const float* a, const float* b, int padded) {
   __m128 l0 = _mm_setzero_ps(), l1 = _mm_setzero_ps(), l2 = _mm_setzero_ps();
   for (int g = 0; g < padded; g += 4) {
     const __m128 v = _mm_load_ps(d + g);
@@ -85,33 +112,79 @@ Sums dot3(const float* d, const float* a, const float* b, int padded) {
   }
   return {{total(l0), total(l1), total(l2)}};
 }
-double sum(const float* v, int padded) {
+double sumSimd(const float* v, int padded) {
   __m128 l = _mm_setzero_ps();
   for (int g = 0; g < padded; g += 4) l = _mm_add_ps(l, _mm_load_ps(v + g));
   return total(l);
 }
-#else
-Sums dot3(const float* d, const float* a, const float* b, int padded) {
-  float l0[4] = {}, l1[4] = {}, l2[4] = {};
-  for (int g = 0; g < padded; g += 4) {
-    for (int k = 0; k < 4; ++k) {
-      const float v = d[g + k];
-      l0[k] += v * v;
-      l1[k] += v * a[g + k];
-      l2[k] += v * b[g + k];
-    }
+#elif defined(MCSLAM_ALIGN_HAVE_NEON)
+// Multiplies and adds stay separate (this library is built with -ffp-contract=off): x86-64 has no fused form.
+void sampleBilinearSimd(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
+  for (int g = 0; g < count; g += 4) {
+    const float32x4_t x = vld1q_f32(xs + g), y = vld1q_f32(ys + g);
+    const int32x4_t xi = vcvtq_s32_f32(x), yi = vcvtq_s32_f32(y);  // toward zero, as the portable cast
+    const float32x4_t ax = vsubq_f32(x, vcvtq_f32_s32(xi)), ay = vsubq_f32(y, vcvtq_f32_s32(yi));
+    int32_t xk[4], yk[4];
+    vst1q_s32(xk, xi);
+    vst1q_s32(yk, yi);
+    uint32_t words[4];
+    for (int k = 0; k < 4; ++k) words[k] = pixelWord(im, xk[k], yk[k]);
+    const uint32x4_t w = vld1q_u32(words);
+    const uint32x4_t byte = vdupq_n_u32(0xFF);
+    const float32x4_t p00 = vcvtq_f32_u32(vandq_u32(w, byte));
+    const float32x4_t p10 = vcvtq_f32_u32(vandq_u32(vshrq_n_u32(w, 8), byte));
+    const float32x4_t p01 = vcvtq_f32_u32(vandq_u32(vshrq_n_u32(w, 16), byte));
+    const float32x4_t p11 = vcvtq_f32_u32(vshrq_n_u32(w, 24));
+    const float32x4_t top = vaddq_f32(p00, vmulq_f32(ax, vsubq_f32(p10, p00)));
+    const float32x4_t bottom = vaddq_f32(p01, vmulq_f32(ax, vsubq_f32(p11, p01)));
+    vst1q_f32(out + g, vaddq_f32(top, vmulq_f32(ay, vsubq_f32(bottom, top))));
   }
-  auto total = [](const float* l) { return (static_cast<double>(l[0]) + l[1]) + (static_cast<double>(l[2]) + l[3]); };
+}
+double total(float32x4_t l) {
+  float v[4];
+  vst1q_f32(v, l);
+  return total4(v);
+}
+Sums dot3Simd(const float* d, const float* a, const float* b, int padded) {
+  float32x4_t l0 = vdupq_n_f32(0), l1 = vdupq_n_f32(0), l2 = vdupq_n_f32(0);
+  for (int g = 0; g < padded; g += 4) {
+    const float32x4_t v = vld1q_f32(d + g);
+    l0 = vaddq_f32(l0, vmulq_f32(v, v));
+    l1 = vaddq_f32(l1, vmulq_f32(v, vld1q_f32(a + g)));
+    l2 = vaddq_f32(l2, vmulq_f32(v, vld1q_f32(b + g)));
+  }
   return {{total(l0), total(l1), total(l2)}};
 }
-double sum(const float* v, int padded) {
-  float l[4] = {};
-  for (int g = 0; g < padded; g += 4) {
-    for (int k = 0; k < 4; ++k) l[k] += v[g + k];
-  }
-  return (static_cast<double>(l[0]) + l[1]) + (static_cast<double>(l[2]) + l[3]);
+double sumSimd(const float* v, int padded) {
+  float32x4_t l = vdupq_n_f32(0);
+  for (int g = 0; g < padded; g += 4) l = vaddq_f32(l, vld1q_f32(v + g));
+  return total(l);
 }
 #endif
+
+#if defined(MCSLAM_ALIGN_HAVE_SSE2) || defined(MCSLAM_ALIGN_HAVE_NEON)
+constexpr bool kHaveSimd = true;
+#else
+constexpr bool kHaveSimd = false;
+void sampleBilinearSimd(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
+  sampleBilinearPortable(im, xs, ys, count, out);
+}
+Sums dot3Simd(const float* d, const float* a, const float* b, int padded) { return dot3Portable(d, a, b, padded); }
+double sumSimd(const float* v, int padded) { return sumPortable(v, padded); }
+#endif
+
+// The kernels of one alignment: the vector ones where the build has them and the options want them.
+struct Kernels {
+  bool simd;
+  explicit Kernels(const EpipolarAlignmentOptions& o) : simd(kHaveSimd && o.use_simd) {}
+  void sampleBilinear(const ImageView& im, const float* xs, const float* ys, int count, float* out) const {
+    simd ? sampleBilinearSimd(im, xs, ys, count, out) : sampleBilinearPortable(im, xs, ys, count, out);
+  }
+  Sums dot3(const float* d, const float* a, const float* b, int padded) const {
+    return simd ? dot3Simd(d, a, b, padded) : dot3Portable(d, a, b, padded);
+  }
+  double sum(const float* v, int padded) const { return simd ? sumSimd(v, padded) : sumPortable(v, padded); }
+};
 
 }  // namespace
 
@@ -139,7 +212,8 @@ bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spac
     gx[k] = static_cast<float>(ref_uv.x());
     gy[k] = static_cast<float>(ref_uv.y());
   }
-  sampleBilinear(ref, gx, gy, grid_padded, g);
+  const Kernels kernels(options);
+  kernels.sampleBilinear(ref, gx, gy, grid_padded, g);
   const float inv_2s = static_cast<float>(1.0 / (2 * spacing));
   int k = 0;
   for (int j = 1; j < side - 1; ++j) {
@@ -152,9 +226,9 @@ bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spac
   }
   for (; k < t.padded; ++k) t.value[k] = t.dx[k] = t.dy[k] = 0;
   const double n = t.samples;
-  const float mean_v = static_cast<float>(sum(t.value, t.padded) / n);
-  const float mean_x = static_cast<float>(sum(t.dx, t.padded) / n),
-              mean_y = static_cast<float>(sum(t.dy, t.padded) / n);
+  const float mean_v = static_cast<float>(kernels.sum(t.value, t.padded) / n);
+  const float mean_x = static_cast<float>(kernels.sum(t.dx, t.padded) / n),
+              mean_y = static_cast<float>(kernels.sum(t.dy, t.padded) / n);
   for (k = 0; k < t.samples; ++k) {
     t.value[k] -= mean_v;
     t.dx[k] -= mean_x;
@@ -162,7 +236,7 @@ bool makeAlignmentTemplate(const ImageView& ref, const Vec2& ref_uv, double spac
   }
   // Zero mean, unit norm; the derivatives' means are removed with the template's own (the residual is blind to a
   // constant).
-  const double var = dot3(t.value, t.value, t.value, t.padded).s[0];
+  const double var = kernels.dot3(t.value, t.value, t.value, t.padded).s[0];
   if (!(var > 1e-6)) return false;
   const float inv_norm = static_cast<float>(1.0 / std::sqrt(var));
   for (k = 0; k < t.samples; ++k) {
@@ -210,7 +284,8 @@ struct PartnerWarp {
   double hessian = 0, grad_dot_tmpl = 0;
 };
 
-void warpTemplate(const AlignmentTemplate& t, const Vec2& direction, const Mat2& A, PartnerWarp& pw) {
+void warpTemplate(const AlignmentTemplate& t, const Vec2& direction, const Mat2& A, const Kernels& kernels,
+                  PartnerWarp& pw) {
   const int h = t.half, padded = t.padded;
   const double spacing = t.spacing;
   // A shift s along the direction in the partner moves the reference grid by s * w: the template's derivative
@@ -227,7 +302,7 @@ void warpTemplate(const AlignmentTemplate& t, const Vec2& direction, const Mat2&
     }
   }
   for (; k < padded; ++k) pw.off_x[k] = pw.off_y[k] = 0;  // padding: the centre
-  const Sums gs = dot3(pw.grad, t.value, t.value, padded);
+  const Sums gs = kernels.dot3(pw.grad, t.value, t.value, padded);
   pw.hessian = gs.s[0];
   pw.grad_dot_tmpl = gs.s[1];
 }
@@ -239,6 +314,7 @@ ShiftOutcome iterateShift(const AlignmentTemplate& t, const PartnerWarp& pw, con
                           const Vec2& direction, double max_shift, const EpipolarAlignmentOptions& options, double& s,
                           double& zncc, double& residual2) {
   const int n = t.samples, padded = t.padded;
+  const Kernels kernels(options);
   alignas(16) float xs[kMaxPadded], ys[kMaxPadded], values[kMaxPadded];
   double previous_s = 0, previous_b = 0;
   for (int it = 0; it < options.max_iterations; ++it) {
@@ -248,13 +324,13 @@ ShiftOutcome iterateShift(const AlignmentTemplate& t, const PartnerWarp& pw, con
       xs[k] = cx + pw.off_x[k];
       ys[k] = cy + pw.off_y[k];
     }
-    sampleBilinear(image, xs, ys, padded, values);
+    kernels.sampleBilinear(image, xs, ys, padded, values);
     for (int k = n; k < padded; ++k) values[k] = 0;
-    const float mean = static_cast<float>(sum(values, padded) / n);
+    const float mean = static_cast<float>(kernels.sum(values, padded) / n);
     for (int k = 0; k < n; ++k) values[k] -= mean;
     // With both patches zero mean, and the template and its derivative too: the correlation and the residual's
     // derivative need only the partner's norm and two dot products.
-    const Sums vs = dot3(values, t.value, pw.grad, padded);
+    const Sums vs = kernels.dot3(values, t.value, pw.grad, padded);
     const double var = vs.s[0];
     if (!(var > 1e-6)) return ShiftOutcome::NoTexture;
     const double inv_norm = 1.0 / std::sqrt(var);
@@ -296,7 +372,7 @@ EpipolarAlignment alignAlongEpipolar(const AlignmentTemplate& t, const ImageView
   if (!inside(image, uv0.x(), uv0.y(), ex, ey)) return out;
 
   PartnerWarp pw;
-  warpTemplate(t, direction, A, pw);
+  warpTemplate(t, direction, A, Kernels(options), pw);
   if (!(pw.hessian > 1e-12)) return out;
   double s = 0, zncc = 0, residual2 = 0;
   const ShiftOutcome outcome = iterateShift(t, pw, image, uv0, direction, max_shift, options, s, zncc, residual2);

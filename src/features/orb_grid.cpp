@@ -62,6 +62,38 @@ void collectSse2(const ConstPlane& scores, const Rect& rect, std::vector<Corner>
     }
   }
 }
+#elif defined(MCSLAM_ORB_HAVE_NEON)
+// The SSE2 kernel's test with NEON: each lane's comparison as one bit of a 16-bit mask (lane i is bit i).
+inline unsigned laneMask(uint8x16_t v) {
+  static const uint8_t kBits[16] = {1, 2, 4, 8, 16, 32, 64, 128, 1, 2, 4, 8, 16, 32, 64, 128};
+  const uint8x16_t bits = vandq_u8(v, vld1q_u8(kBits));
+  return vaddv_u8(vget_low_u8(bits)) | (static_cast<unsigned>(vaddv_u8(vget_high_u8(bits))) << 8);
+}
+
+void collectNeon(const ConstPlane& scores, const Rect& rect, std::vector<Corner>& out) {
+  const int stride = scores.stride;
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    const uint8_t* row = scores.row(y);
+    const uint8_t* up = row - stride;
+    const uint8_t* down = row + stride;
+    for (int x = rect.x0; x < rect.x1; x += 16) {
+      const int n = std::min(16, rect.x1 - x);
+      const uint8x16_t s = vld1q_u8(row + x);
+      if (vmaxvq_u8(s) == 0) continue;
+      const unsigned lanes = n == 16 ? 0xFFFFu : (1u << n) - 1;
+      const uint8x16_t before = vmaxq_u8(vmaxq_u8(vld1q_u8(up + x - 1), vld1q_u8(up + x)),
+                                         vmaxq_u8(vld1q_u8(up + x + 1), vld1q_u8(row + x - 1)));
+      const uint8x16_t after = vmaxq_u8(vmaxq_u8(vld1q_u8(down + x - 1), vld1q_u8(down + x)),
+                                        vmaxq_u8(vld1q_u8(down + x + 1), vld1q_u8(row + x + 1)));
+      // s non-zero, s >= every neighbour before it, s > every neighbour after it.
+      const uint8x16_t keep = vandq_u8(vtstq_u8(s, s), vandq_u8(vcgeq_u8(s, before), vcgtq_u8(s, after)));
+      for (unsigned mask = laneMask(keep) & lanes; mask != 0; mask &= mask - 1) {
+        const int i = __builtin_ctz(mask);
+        if (out.size() < out.capacity()) out.push_back({x + i, y, static_cast<float>(row[x + i])});
+      }
+    }
+  }
+}
 #endif
 
 }  // namespace
@@ -69,6 +101,8 @@ void collectSse2(const ConstPlane& scores, const Rect& rect, std::vector<Corner>
 void collectLocalMaxima(const ConstPlane& scores, const Rect& rect, std::vector<Corner>& out, bool use_simd) {
 #if defined(MCSLAM_ORB_HAVE_SSE2)
   if (use_simd) return collectSse2(scores, rect, out);
+#elif defined(MCSLAM_ORB_HAVE_NEON)
+  if (use_simd) return collectNeon(scores, rect, out);
 #else
   (void)use_simd;
 #endif

@@ -21,7 +21,7 @@ struct Rect {
 // to the later pixel in raster order, so no two kept corners touch: at most one per 2x2 block, which
 // bounds the list (maxLocalMaxima). The one-pixel frame around the scored area must be zero.
 // Never grows `out` beyond its capacity. Reads up to 16 bytes past rect.x1 (the planes are padded).
-// use_simd: the SSE2 kernel where the build has it; both give the same corners in the same order.
+// use_simd: the SSE2 or NEON kernel where the build has it; both give the same corners in the same order.
 void collectLocalMaxima(const ConstPlane& scores, const Rect& rect, std::vector<Corner>& out, bool use_simd = true);
 inline int maxLocalMaxima(int width, int height) { return ((width + 1) / 2) * ((height + 1) / 2); }
 

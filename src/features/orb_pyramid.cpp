@@ -44,6 +44,21 @@ void resampleRow(const int16_t* row, const DownscaleScratch& scratch, int width,
     const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(s0, s1), _mm_setzero_si128());
     _mm_storel_epi64(reinterpret_cast<__m128i*>(out + x), bytes);
   }
+#elif defined(MCSLAM_ORB_HAVE_NEON)
+  // Four pairs per register as 32-bit words: low * left weight + high * right weight, as above (exact integers).
+  auto gather4 = [&](int i) {
+    uint32_t p[4];
+    for (int k = 0; k < 4; ++k) std::memcpy(&p[k], row + scratch.src_x[i + k], sizeof(uint32_t));
+    return vld1q_u32(p);
+  };
+  const uint32x4_t low16 = vdupq_n_u32(0xFFFFu);
+  auto weigh4 = [&](int i) {
+    const uint32x4_t pairs = gather4(i), w = vld1q_u32(scratch.weights + i);
+    const uint32x4_t sum =
+        vmlaq_u32(vmulq_u32(vandq_u32(pairs, low16), vandq_u32(w, low16)), vshrq_n_u32(pairs, 16), vshrq_n_u32(w, 16));
+    return vqmovn_u32(vshrq_n_u32(vaddq_u32(sum, vdupq_n_u32(kRound)), kShift));
+  };
+  for (; use_simd && x + 8 <= width; x += 8) vst1_u8(out + x, vqmovn_u16(vcombine_u16(weigh4(x), weigh4(x + 4))));
 #else
   (void)use_simd;
 #endif

@@ -28,7 +28,7 @@ struct DownscaleScratch {
 
 // Bilinear resampling where destination pixel x samples source (x + 0.5) * ratio - 0.5 (pixel centres
 // aligned, as the keypoint coordinates assume). dst.width/height say the destination size. Fixed point,
-// 8-bit weights; use_simd picks the SSE2 path where there is one (identical results).
+// 8-bit weights; use_simd picks the SSE2 or NEON path where there is one (identical results).
 void downscale(const ConstPlane& src, const Plane& dst, float ratio, const DownscaleScratch& scratch, bool use_simd);
 
 // 7x7 Gaussian, sigma 2 (the smoothing rBRIEF's tests assume), borders replicated. tmp: src-sized.

@@ -6,10 +6,12 @@
 #include <cstdio>
 #include <numbers>
 
+#include "integer_image.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/features/orb_extractor.hpp"
 #include "orb_fast.hpp"
 #include "orb_grid.hpp"
+#include "orb_pyramid.hpp"
 #include "orb_test_images.hpp"
 
 namespace mcslam {
@@ -148,6 +150,85 @@ TEST(OrbExtractor, SimdAndScalarKernelsGiveIdenticalFeatures) {
   const FeatureSet b = extractWith(scalar, frame640().view());
   EXPECT_EQ(a.count, simd.max_features);
   expectSame(a, b);
+}
+
+// The same image gives the same keypoints and descriptors on every architecture and every kernel: an image made of
+// integers only, each kernel's output from the vector (SSE2/AVX2 or NEON) and the portable path, and digests of them
+// recorded on x86-64. tools/test-arm64.sh runs this test on an arm64 build under qemu-user.
+TEST(OrbExtractor, SameFeaturesOnEveryArchitectureAndKernel) {
+  // Recorded on x86-64 (AVX2 and SSE2 kernels, and the portable ones, agree there).
+  constexpr uint64_t kImage = 0x0f6064f9e469504e, kFast = 0x55560c9df8960aa4, kBlur = 0x3969d2e0910d68bf,
+                     kDownscale = 0xf036ca1b8695bad4, kFeatures = 0x21e6c9120c6a6bab;
+  const Image img = test::integerFrame(640, 480, 7);
+  const int w = img.width(), h = img.height();
+  test::Fnv1a image_digest;
+  image_digest.bytes(img.data(), static_cast<size_t>(w) * static_cast<size_t>(h));
+
+  // FAST scores of every row at a low threshold, from each kernel.
+  std::vector<uint8_t> padded(static_cast<size_t>(w) * static_cast<size_t>(h) + 64, 0);
+  std::copy(img.data(), img.data() + static_cast<size_t>(w) * static_cast<size_t>(h), padded.begin());
+  test::Fnv1a fast_digest;
+  std::vector<uint8_t> scalar_row(static_cast<size_t>(w)), row(static_cast<size_t>(w));
+  int corners = 0;
+  for (int y = 3; y < h - 3; ++y) {
+    const int n = orb_detail::fastScoreRow(padded.data(), w, y, 3, w - 3, 10, scalar_row.data(),
+                                           orb_detail::FastBackend::kScalar);
+    for (auto backend : {orb_detail::FastBackend::kNative, orb_detail::FastBackend::kWide}) {
+      ASSERT_EQ(orb_detail::fastScoreRow(padded.data(), w, y, 3, w - 3, 10, row.data(), backend), n) << y;
+      ASSERT_TRUE(std::equal(row.begin(), row.begin() + (w - 6), scalar_row.begin())) << "row " << y;
+    }
+    fast_digest.bytes(scalar_row.data(), static_cast<size_t>(w - 6));
+    corners += n;
+  }
+  EXPECT_GT(corners, 5000);
+
+  // The descriptor's smoothing and the pyramid's resampling, both kernels.
+  const orb_detail::ConstPlane source(padded.data(), w, h, w);
+  std::vector<uint8_t> tmp(padded.size()), blurred(padded.size()), blurred_portable(padded.size());
+  orb_detail::gaussianBlur7(source, {blurred.data(), w, h, w}, {tmp.data(), w, h, w}, true);
+  orb_detail::gaussianBlur7(source, {blurred_portable.data(), w, h, w}, {tmp.data(), w, h, w}, false);
+  ASSERT_EQ(blurred, blurred_portable);
+  test::Fnv1a blur_digest;
+  blur_digest.bytes(blurred.data(), static_cast<size_t>(w) * static_cast<size_t>(h));
+  const int dw = static_cast<int>(std::lround(w / 1.2)), dh = static_cast<int>(std::lround(h / 1.2));
+  std::vector<int32_t> src_x(static_cast<size_t>(w) + 1);
+  std::vector<uint32_t> weights(static_cast<size_t>(w) + 1);
+  std::vector<int16_t> resample_row(static_cast<size_t>(w) + 1);
+  std::vector<uint8_t> small(padded.size()), small_portable(padded.size());
+  const orb_detail::DownscaleScratch scratch{src_x.data(), weights.data(), resample_row.data()};
+  orb_detail::downscale(source, {small.data(), dw, dh, w}, 1.2f, scratch, true);
+  orb_detail::downscale(source, {small_portable.data(), dw, dh, w}, 1.2f, scratch, false);
+  ASSERT_EQ(small, small_portable);
+  test::Fnv1a downscale_digest;
+  downscale_digest.bytes(small.data(), static_cast<size_t>(w) * static_cast<size_t>(dh));
+
+  // The whole extractor: keypoints (position, angle, response, octave) and descriptors, bit for bit.
+  OrbOptions simd, portable;
+  portable.use_simd = false;
+  const FeatureSet a = extractWith(simd, img.view());
+  const FeatureSet b = extractWith(portable, img.view());
+  EXPECT_EQ(a.count, simd.max_features);
+  expectSame(a, b);
+  test::Fnv1a features_digest;
+  for (int i = 0; i < a.count; ++i) {
+    const Keypoint& k = a.keypoints[i];
+    features_digest.add(k.x);
+    features_digest.add(k.y);
+    features_digest.add(k.angle);
+    features_digest.add(k.response);
+    features_digest.add(k.octave);
+    features_digest.add(a.descriptors[i]);
+  }
+
+  std::printf("digests: image 0x%016llx fast 0x%016llx blur 0x%016llx downscale 0x%016llx features 0x%016llx\n",
+              static_cast<unsigned long long>(image_digest.h), static_cast<unsigned long long>(fast_digest.h),
+              static_cast<unsigned long long>(blur_digest.h), static_cast<unsigned long long>(downscale_digest.h),
+              static_cast<unsigned long long>(features_digest.h));
+  EXPECT_EQ(image_digest.h, kImage) << "the test image itself differs";
+  EXPECT_EQ(fast_digest.h, kFast);
+  EXPECT_EQ(blur_digest.h, kBlur);
+  EXPECT_EQ(downscale_digest.h, kDownscale);
+  EXPECT_EQ(features_digest.h, kFeatures);
 }
 
 TEST(OrbExtractor, FillsTheBudgetInsideTheImageAndSpreadsIt) {

@@ -28,6 +28,9 @@ struct EpipolarAlignmentOptions {
   // Position sigma added in quadrature to the one the residual gives: bilinear interpolation and the affine patch
   // model are not exact (a fraction of a sample spacing).
   double sigma_floor_spacings = 0.05;
+  // The SSE2 (x86-64) or NEON (AArch64) kernels where the build has them; false: the portable ones. Both give
+  // identical results (tests/frontend/epipolar_alignment_test.cpp).
+  bool use_simd = true;
 };
 
 enum class AlignmentStatus : uint8_t {
