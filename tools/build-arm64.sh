@@ -3,11 +3,11 @@
 # Debian's own -dev packages, and installs what is missing for that (only the missing host packages, like
 # tools/setup.sh; the root once). Executables run on this machine through qemu-user (tools/test-arm64.sh).
 #
-# Usage: tools/build-arm64.sh [TARGET...]        (no target: everything; e.g. `arm64-ci` for what CI tests)
+# Usage: tools/build-arm64.sh [TARGET...]        (no target: everything; `arm64-ci`: the subset meant for CI)
 #   MCSLAM_ARM64_ROOT   where the arm64 root lives (default ~/.cache/mcslam/arm64-root-bookworm, ~1.3 GB): made with
 #                       mmdebstrap (extract variant: the packages unpacked, no foreign code run), remade when the
 #                       package list below changes
-#   MCSLAM_CMAKE_ARGS   extra CMake arguments (CI passes -DMCSLAM_WERROR=ON)
+#   MCSLAM_CMAKE_ARGS   extra CMake arguments (e.g. -DMCSLAM_WERROR=ON)
 # Why a root and not multiarch (dpkg --add-architecture arm64): libopencv-dev, libyaml-cpp-dev and OpenCV's and
 # Ceres' dependencies are not Multi-Arch: same, so their arm64 -dev packages cannot be installed beside the amd64
 # ones tools/setup.sh installs (docs/arm64.md).
@@ -24,17 +24,8 @@ root_packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libceres-dev
 )
 
-sudo=""
-[ "$(id -u)" -eq 0 ] || sudo="sudo"
-missing=()
-for p in "${host_packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "build-arm64: installing ${missing[*]}"
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
-fi
+source tools/install-packages.sh
+install_missing build-arm64 "${host_packages[@]}"
 
 stamp="bookworm arm64 ${root_packages[*]}"
 if [ "$(cat "$root/.mcslam-root" 2>/dev/null)" != "$stamp" ]; then

@@ -4,10 +4,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! command -v clang-format >/dev/null; then
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q >/dev/null
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends clang-format >/dev/null
+  source tools/install-packages.sh
+  install_missing check-format clang-format >/dev/null
 fi
 mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h' '*.cc')
 if [ "${1:-}" = "--fix" ]; then

@@ -11,17 +11,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libceres-dev
   systemd ccache
 )
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  echo "setup: installing ${missing[*]}"
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update -q
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
-fi
+source tools/install-packages.sh
+install_missing setup "${packages[@]}"
 
 jobs="$(nproc)"
 # ccache (when installed) makes rebuilds after a checkout or a clean cheap.
