@@ -66,7 +66,7 @@ double sumPortable(const float* v, int padded) {
 }
 
 // The pixel pairs of both rows of sample k as one 32-bit word (top pair low): the loads, not the arithmetic,
-// are the per-sample work (a frame aligns thousands of partners, each in a few iterations of 49 samples).
+// are the per-sample work.
 inline uint32_t pixelWord(const ImageView& im, int32_t x, int32_t y) {
   const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(y) * im.stride + x;
   uint16_t top, bottom;
@@ -118,7 +118,7 @@ double sumSimd(const float* v, int padded) {
   return total(l);
 }
 #elif defined(MCSLAM_ALIGN_HAVE_NEON)
-// Multiplies and adds stay separate (this library is built with -ffp-contract=off): x86-64 has no fused form.
+// Multiplies and adds stay separate, as on x86-64, which has no fused form (non-x86 builds use -ffp-contract=off).
 void sampleBilinearSimd(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
   for (int g = 0; g < count; g += 4) {
     const float32x4_t x = vld1q_f32(xs + g), y = vld1q_f32(ys + g);
