@@ -1,17 +1,11 @@
 #include "mcslam/geometry/relative_pose.hpp"
 
 #include <algorithm>
-#include <climits>
-#include <memory>
-#include <opengv/relative_pose/CentralRelativeAdapter.hpp>
-#include <opengv/relative_pose/NoncentralRelativeAdapter.hpp>
-#include <opengv/relative_pose/methods.hpp>
-#include <opengv/sac/Ransac.hpp>
-#include <opengv/sac_problems/relative_pose/CentralRelativePoseSacProblem.hpp>
-#include <opengv/sac_problems/relative_pose/NoncentralRelativePoseSacProblem.hpp>
+#include <array>
 
 #include "mcslam/geometry/ransac.hpp"
 #include "mcslam/geometry/relative_pose_refinement.hpp"
+#include "mcslam/geometry/relative_pose_solvers.hpp"
 
 namespace mcslam {
 
@@ -19,42 +13,56 @@ using namespace relative_pose_detail;
 
 namespace {
 
-// OpenGV's problems seed their generator from the clock or with a constant; ours draws the samples
-// from our seeded generator instead, so the caller's seed decides.
-template <class Problem>
-class SeededProblem : public Problem {
- public:
-  template <class... Args>
-  explicit SeededProblem(uint64_t seed, Args&&... args) : Problem(std::forward<Args>(args)...), random_(seed) {}
+struct Refined {
+  SE3 T;
+  std::vector<uint8_t> mask;  // one per ray (capacity reserved by the workspace)
+  int inliers = 0;
+  double cost = INFINITY;  // sum of squared errors over the inliers
+};
 
-  void getSamples(int& iterations, std::vector<int>& samples) override {
-    const std::vector<int>& indices = *this->getIndices();
-    const int k = this->getSampleSize();
-    const int n = static_cast<int>(indices.size());
-    if (n < k) {
-      samples.clear();
-      iterations = INT_MAX;
-      return;
-    }
-    samples.resize(k);
-    random_.distinct(n, k, samples.data());
-    for (int& s : samples) s = indices[s];
+}  // namespace
+
+// Every buffer of an estimation, sized once.
+struct RelativePoseEstimator::Workspace {
+  Workspace(int max_correspondences, int max_cameras) : capacity(static_cast<std::size_t>(max_correspondences)) {
+    index.reserve(capacity);
+    rays.reserve(capacity);
+    own_rays.reserve(capacity);
+    for (Refined& h : hypotheses) h.mask.reserve(capacity);
+    own.mask.reserve(capacity);
+    scratch_mask.reserve(capacity);
+    sample_mask.reserve(capacity);
+    scale_candidates.reserve(capacity + 1);
+    parallax.resize(capacity);
+    per_camera.resize(static_cast<std::size_t>(std::max(max_cameras, 1)));
+    result.inlier_mask.reserve(capacity);
   }
-
- private:
-  RansacRandom random_;
+  std::size_t capacity;
+  std::vector<int> index;         // valid correspondences: their index in the caller's matches
+  std::vector<RayPair> rays;      // and their rays
+  std::vector<RayPair> own_rays;  // rotation first: the best-covered camera's rays, in its frame
+  std::array<Refined, 3> hypotheses;
+  Refined own;
+  std::vector<uint8_t> scratch_mask, sample_mask;
+  std::vector<double> scale_candidates, parallax;
+  std::vector<int> per_camera;
+  RelativePoseResult result;
 };
 
-struct Valid {
-  std::vector<int> index;  // into the caller's matches
-  std::vector<RayPair> rays;
-};
+namespace {
 
-// Correspondences with finite bearings and cameras of the rig (all of them when rig is null),
-// normalized, as rays in the frames the pose is solved in.
-Valid validMatches(std::span<const RelativeCorrespondence> matches, const Rig* rig) {
-  Valid v;
-  for (size_t i = 0; i < matches.size(); ++i) {
+using Workspace = RelativePoseEstimator::Workspace;
+
+// Inlier threshold on our (Sampson) angle error.
+double inlierAngle(const RelativePoseOptions& o) { return o.inlier_sigmas * o.bearing_sigma_rad; }
+
+// Correspondences with finite bearings and cameras of the rig (all of them when rig is null), normalized, as
+// rays in the frames the pose is solved in.
+void validMatches(std::span<const RelativeCorrespondence> matches, const Rig* rig, Workspace& ws) {
+  ws.index.clear();
+  ws.rays.clear();
+  const std::size_t n = std::min(matches.size(), ws.capacity);
+  for (std::size_t i = 0; i < n; ++i) {
     const RelativeCorrespondence& m = matches[i];
     const double n1 = m.bearing1.norm(), n2 = m.bearing2.norm();
     if (!(n1 > 0) || !(n2 > 0) || !std::isfinite(n1) || !std::isfinite(n2)) continue;
@@ -66,40 +74,27 @@ Valid validMatches(std::span<const RelativeCorrespondence> matches, const Rig* r
       r.c2 = rig->T_b_c(m.camera2).t;
       r.d2 = rig->T_b_c(m.camera2).R * r.d2;
     }
-    v.index.push_back(static_cast<int>(i));
-    v.rays.push_back(r);
+    ws.index.push_back(static_cast<int>(i));
+    ws.rays.push_back(r);
   }
-  return v;
 }
-
-// Inlier threshold on our (Sampson) angle error.
-double inlierAngle(const RelativePoseOptions& o) { return o.inlier_sigmas * o.bearing_sigma_rad; }
-// The threshold of OpenGV's relative problems: the sum over both views of (1 - cos) of the
-// reprojection angle, for the same number of sigmas in each view.
-double openGvThreshold(const RelativePoseOptions& o) { return 2.0 * (1.0 - std::cos(inlierAngle(o))); }
-
-struct Refined {
-  SE3 T;
-  std::vector<uint8_t> mask;
-  int inliers = 0;
-  double cost = INFINITY;  // sum of squared errors over the inliers
-};
 
 // Our refinement of one hypothesis: select inliers, refine, re-select (the set settles quickly).
 // Generalized poses are refined at fixed scale first, then freely; the free step is kept only if
 // it loses no inliers (where the scale is weak it slides toward t = 0 and points flip behind).
-Refined refineHypothesis(const Valid& v, const SE3& start, bool central, const RelativePoseOptions& o) {
-  Refined r;
+void refineHypothesis(std::span<const RayPair> rays, const SE3& start, bool central, const RelativePoseOptions& o,
+                      std::vector<uint8_t>& free_mask, Refined& r) {
   r.T = start;
   if (central) r.T.t.normalize();
-  selectInliers(v.rays, r.T, inlierAngle(o), r.mask);
-  std::vector<uint8_t> free_mask;
+  r.mask.resize(rays.size());
+  free_mask.resize(rays.size());
+  r.inliers = selectInliers(rays, r.T, inlierAngle(o), r.mask);
   for (int round = 0; round < 3; ++round) {
-    r.T = refineRelativePose(v.rays, r.mask, r.T, true, o);
-    r.inliers = selectInliers(v.rays, r.T, inlierAngle(o), r.mask);
+    r.T = refineRelativePose(rays, r.mask, r.T, true, o);
+    r.inliers = selectInliers(rays, r.T, inlierAngle(o), r.mask);
     if (central) continue;
-    const SE3 free = refineRelativePose(v.rays, r.mask, r.T, false, o);
-    const int free_inliers = selectInliers(v.rays, free, inlierAngle(o), free_mask);
+    const SE3 free = refineRelativePose(rays, r.mask, r.T, false, o);
+    const int free_inliers = selectInliers(rays, free, inlierAngle(o), free_mask);
     if (free_inliers >= r.inliers) {
       r.T = free;
       r.inliers = free_inliers;
@@ -107,10 +102,9 @@ Refined refineHypothesis(const Valid& v, const SE3& start, bool central, const R
     }
   }
   r.cost = 0;
-  for (size_t i = 0; i < v.rays.size(); ++i) {
-    if (r.mask[i]) r.cost += std::pow(sampsonError(v.rays[i], r.T), 2);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (r.mask[i]) r.cost += std::pow(sampsonError(rays[i], r.T), 2);
   }
-  return r;
 }
 
 bool better(const Refined& a, const Refined& b) {
@@ -118,18 +112,18 @@ bool better(const Refined& a, const Refined& b) {
 }
 
 // Inliers, observability and status of the chosen pose, shared by both cases.
-void finish(const Valid& v, const Refined& best, bool central, const RelativePoseOptions& o, size_t num_matches,
-            RelativePoseResult& result) {
+void finish(Workspace& ws, const Refined& best, bool central, const RelativePoseOptions& o, size_t num_matches) {
+  RelativePoseResult& result = ws.result;
   result.T_1_2 = best.T;
   result.metric = !central;
-  result.inlier_mask.assign(num_matches, 0);
+  result.inlier_mask.assign(std::min(num_matches, ws.capacity), 0);
   result.num_inliers = best.inliers;
-  for (size_t i = 0; i < best.mask.size(); ++i) result.inlier_mask[v.index[i]] = best.mask[i];
+  for (size_t i = 0; i < best.mask.size(); ++i) result.inlier_mask[ws.index[i]] = best.mask[i];
   if (result.num_inliers < o.min_inliers) {
     result.status = RelativePoseStatus::NoConsensus;
     return;
   }
-  const Observability obs = analyzeObservability(v.rays, best.mask, best.T, central, o.bearing_sigma_rad);
+  const Observability obs = analyzeObservability(ws.rays, best.mask, best.T, central, o.bearing_sigma_rad, ws.parallax);
   result.relative_scale_sigma = central ? INFINITY : obs.relative_scale_sigma;
   result.direction_sigma_rad = obs.direction_sigma_rad;
   result.median_parallax_rad = obs.median_parallax_rad;
@@ -144,50 +138,111 @@ void finish(const Valid& v, const Refined& best, bool central, const RelativePos
   }
 }
 
-// 5-point RANSAC on central rays; returns false without consensus.
-bool centralRansac(const std::vector<RayPair>& rays, const RelativePoseOptions& o, SE3& T, int& iterations) {
-  opengv::bearingVectors_t b1, b2;
-  for (const RayPair& r : rays) {
-    b1.push_back(r.d1);
-    b2.push_back(r.d2);
+// The one of an essential matrix's four poses that puts the most of the sample's points in front of both
+// cameras; false unless that is all of them.
+bool poseInFront(const Mat3& E, std::span<const RayPair> sample, double max_angle_rad, SE3& T) {
+  Mat3 R_a, R_b;
+  Vec3 t;
+  decomposeEssential(E, R_a, R_b, t);
+  const std::array<SE3, 4> candidates = {SE3(R_a, t), SE3(R_a, -t), SE3(R_b, t), SE3(R_b, -t)};
+  int best = -1;
+  for (const SE3& c : candidates) {
+    const int in_front = countInliers(sample, c, max_angle_rad);
+    if (in_front > best) {
+      best = in_front;
+      T = c;
+    }
   }
-  opengv::relative_pose::CentralRelativeAdapter adapter(b1, b2);
-  using Problem = opengv::sac_problems::relative_pose::CentralRelativePoseSacProblem;
-  opengv::sac::Ransac<SeededProblem<Problem>> ransac;
-  ransac.sac_model_ = std::make_shared<SeededProblem<Problem>>(o.seed, adapter, Problem::NISTER, false);
-  ransac.threshold_ = openGvThreshold(o);
-  ransac.max_iterations_ = o.max_iterations;
-  ransac.probability_ = o.confidence;
-  const bool found = ransac.computeModel();
-  iterations += ransac.iterations_;
-  if (!found || static_cast<int>(ransac.inliers_.size()) < std::max(8, o.min_inliers / 4)) return false;
-  const opengv::transformation_t& M = ransac.model_coefficients_;
-  T = SE3(M.leftCols<3>(), M.col(3).normalized());
-  return true;
+  return best == static_cast<int>(sample.size());
+}
+
+// The adaptive RANSAC loop: draws samples of `k`, lets `hypotheses(sample, consider)` call consider(pose) for each
+// pose the sample gives, keeps the pose with the most inliers. Returns that count (-1 without any).
+template <int k, class Hypotheses>
+int ransac(std::span<const RayPair> rays, const RelativePoseOptions& o, Hypotheses&& hypotheses, SE3& best_pose,
+           int& iterations) {
+  const int n = static_cast<int>(rays.size());
+  if (n < k) return -1;
+  RansacRandom random(o.seed);
+  std::array<int, k> sample{};
+  int best = -1;
+  int needed = o.max_iterations;
+  int it = 0;
+  for (; it < std::min(needed, o.max_iterations); ++it) {
+    random.distinct(n, k, sample.data());
+    hypotheses(sample, [&](const SE3& pose) {
+      const int count = countInliers(rays, pose, inlierAngle(o));
+      if (count <= best) return;
+      best = count;
+      best_pose = pose;
+      needed = ransacIterationsNeeded(static_cast<double>(count) / n, k, o.confidence);
+    });
+  }
+  iterations += it;
+  return best;
+}
+
+// 5-point RANSAC on central rays; false without consensus.
+bool centralRansac(std::span<const RayPair> rays, const RelativePoseOptions& o, SE3& T, int& iterations) {
+  std::array<Mat3, 10> E;
+  std::array<RayPair, 5> picked;
+  std::array<Vec3, 5> d1, d2;
+  auto fivePoint = [&](const std::array<int, 5>& sample, auto&& consider) {
+    for (int i = 0; i < 5; ++i) {
+      picked[i] = rays[sample[i]];
+      d1[i] = picked[i].d1;
+      d2[i] = picked[i].d2;
+    }
+    const int solutions = fivePointEssential(d1, d2, E);
+    for (int s = 0; s < solutions; ++s) {
+      SE3 pose;
+      if (poseInFront(E[s], picked, inlierAngle(o), pose)) consider(pose);
+    }
+  };
+  const int inliers = ransac<5>(rays, o, fivePoint, T, iterations);
+  return inliers >= std::max(8, o.min_inliers / 4);
+}
+
+// 17-point RANSAC on generalized rays; false without consensus.
+bool generalizedRansac(std::span<const RayPair> rays, const RelativePoseOptions& o, std::vector<uint8_t>& sample_mask,
+                       SE3& T, int& iterations) {
+  sample_mask.assign(rays.size(), 0);
+  std::array<SE3, 2> poses;
+  auto seventeenPoint = [&](const std::array<int, 17>& sample, auto&& consider) {
+    for (int i : sample) sample_mask[i] = 1;
+    const bool solved = linearGeneralizedPose(rays, sample_mask, poses);
+    for (int i : sample) sample_mask[i] = 0;
+    if (!solved) return;
+    for (const SE3& pose : poses) consider(pose);
+  };
+  return ransac<17>(rays, o, seventeenPoint, T, iterations) >= 17;
 }
 
 // Rotation-first hypothesis for rigs whose matches stay within cameras (where the 17-point solver
 // is weakest: little rotation, non-overlapping cameras): the camera with the most matches gives
 // the rotation and the direction of its own motion by the 5-point solver; the metric scale along
 // that direction is then the value most matches of all cameras agree with.
-bool rotationFirstHypothesis(const Rig& rig, std::span<const RelativeCorrespondence> matches, const Valid& v,
-                             const RelativePoseOptions& o, SE3& T, int& iterations) {
-  std::vector<int> count(rig.size(), 0);
-  for (int i : v.index) {
-    if (matches[i].camera1 == matches[i].camera2) ++count[matches[i].camera1];
+bool rotationFirstHypothesis(const Rig& rig, std::span<const RelativeCorrespondence> matches,
+                             const RelativePoseOptions& o, Workspace& ws, SE3& T, int& iterations) {
+  std::vector<int>& count = ws.per_camera;
+  std::fill(count.begin(), count.end(), 0);
+  const int cameras = std::min(rig.size(), static_cast<int>(count.size()));
+  for (int i : ws.index) {
+    const RelativeCorrespondence& m = matches[i];
+    if (m.camera1 == m.camera2 && m.camera1 < cameras) ++count[m.camera1];
   }
-  const int cam = static_cast<int>(std::max_element(count.begin(), count.end()) - count.begin());
+  const int cam = static_cast<int>(std::max_element(count.begin(), count.begin() + cameras) - count.begin());
   if (count[cam] < 16) return false;
-  Valid own;
-  for (size_t k = 0; k < v.index.size(); ++k) {
-    const RelativeCorrespondence& m = matches[v.index[k]];
+  ws.own_rays.clear();
+  for (int i : ws.index) {
+    const RelativeCorrespondence& m = matches[i];
     if (m.camera1 != cam || m.camera2 != cam) continue;
-    own.index.push_back(static_cast<int>(k));
-    own.rays.push_back({Vec3::Zero(), m.bearing1.normalized(), Vec3::Zero(), m.bearing2.normalized()});
+    ws.own_rays.push_back({Vec3::Zero(), m.bearing1.normalized(), Vec3::Zero(), m.bearing2.normalized()});
   }
   SE3 T_c;
-  if (!centralRansac(own.rays, o, T_c, iterations)) return false;
-  T_c = refineHypothesis(own, T_c, true, o).T;
+  if (!centralRansac(ws.own_rays, o, T_c, iterations)) return false;
+  refineHypothesis(ws.own_rays, T_c, true, o, ws.scratch_mask, ws.own);
+  T_c = ws.own.T;
 
   // Body motion as a function of the camera's unknown scale s: t(s) = t0 + s * dir.
   const SE3& T_b_c = rig.T_b_c(cam);
@@ -198,8 +253,9 @@ bool rotationFirstHypothesis(const Rig& rig, std::span<const RelativeCorresponde
   // The camera moved along +dir (the 5-point solution is in front of the camera), so s > 0. When
   // nothing fixes s (no rotation) any value fits: s = 1 is then as good as another and the
   // observability check reports it.
-  std::vector<double> candidates{1.0};
-  for (const RayPair& p : v.rays) {
+  std::vector<double>& candidates = ws.scale_candidates;
+  candidates.assign(1, 1.0);
+  for (const RayPair& p : ws.rays) {
     const double beta = sampsonError(p, SE3(R, t0));
     const double alpha = sampsonError(p, SE3(R, t0 + dir)) - beta;  // e is affine in t (normalization frozen)
     if (std::abs(alpha) > 1e-12 && -beta / alpha > 0) candidates.push_back(-beta / alpha);
@@ -207,12 +263,11 @@ bool rotationFirstHypothesis(const Rig& rig, std::span<const RelativeCorresponde
   RansacRandom random(o.seed);
   int best_inliers = -1;
   double best_s = 1.0;
-  std::vector<uint8_t> mask;
   const int tries = std::min<int>(static_cast<int>(candidates.size()), 300);
   for (int k = 0; k < tries; ++k) {
     const double s =
         candidates.size() <= 300 ? candidates[k] : candidates[random.below(static_cast<int>(candidates.size()))];
-    const int inl = selectInliers(v.rays, SE3(R, t0 + s * dir), inlierAngle(o), mask);
+    const int inl = countInliers(ws.rays, SE3(R, t0 + s * dir), inlierAngle(o));
     if (inl > best_inliers) {
       best_inliers = inl;
       best_s = s;
@@ -220,6 +275,30 @@ bool rotationFirstHypothesis(const Rig& rig, std::span<const RelativeCorresponde
   }
   T = SE3(R, t0 + best_s * dir);
   return true;
+}
+
+// The linear solver on all the inliers of the RANSAC pose: far less noisy than on 17 points.
+bool allInlierHypothesis(const SE3& ransac_pose, const RelativePoseOptions& o, Workspace& ws, SE3& T) {
+  ws.sample_mask.resize(ws.rays.size());
+  selectInliers(ws.rays, ransac_pose, inlierAngle(o), ws.sample_mask);
+  std::array<SE3, 2> poses;
+  if (!linearGeneralizedPose(ws.rays, ws.sample_mask, poses)) return false;
+  const int a = countInliers(ws.rays, poses[0], inlierAngle(o));
+  const int b = countInliers(ws.rays, poses[1], inlierAngle(o));
+  T = a >= b ? poses[0] : poses[1];
+  return true;
+}
+
+void clearResult(RelativePoseResult& result, std::size_t matches, std::size_t capacity) {
+  result.inlier_mask.assign(std::min(matches, capacity), 0);
+  result.status = RelativePoseStatus::TooFewCorrespondences;
+  result.T_1_2 = SE3();
+  result.metric = false;
+  result.num_inliers = 0;
+  result.ransac_iterations = 0;
+  result.relative_scale_sigma = INFINITY;
+  result.direction_sigma_rad = INFINITY;
+  result.median_parallax_rad = 0;
 }
 
 }  // namespace
@@ -236,76 +315,75 @@ const char* relativePoseStatusName(RelativePoseStatus s) {
   return "?";
 }
 
-RelativePoseResult estimateGeneralizedRelativePose(const Rig& rig, std::span<const RelativeCorrespondence> matches,
-                                                   const RelativePoseOptions& o) {
-  RelativePoseResult result;
-  result.inlier_mask.assign(matches.size(), 0);
+RelativePoseEstimator::RelativePoseEstimator(int max_correspondences, int max_cameras)
+    : ws_(std::make_unique<Workspace>(std::max(max_correspondences, 0), max_cameras)) {}
+RelativePoseEstimator::~RelativePoseEstimator() = default;
+RelativePoseEstimator::RelativePoseEstimator(RelativePoseEstimator&&) noexcept = default;
+RelativePoseEstimator& RelativePoseEstimator::operator=(RelativePoseEstimator&&) noexcept = default;
+
+const RelativePoseResult& RelativePoseEstimator::generalized(const Rig& rig,
+                                                             std::span<const RelativeCorrespondence> matches,
+                                                             const RelativePoseOptions& o) {
+  Workspace& ws = *ws_;
+  RelativePoseResult& result = ws.result;
+  clearResult(result, matches.size(), ws.capacity);
   if (rig.size() < 2) {  // one camera: no metric scale
     result.status = RelativePoseStatus::ScaleUnobservable;
     return result;
   }
-  const Valid v = validMatches(matches, &rig);
-  if (static_cast<int>(v.rays.size()) < std::max(17, o.min_inliers)) return result;
+  validMatches(matches, &rig, ws);
+  if (static_cast<int>(ws.rays.size()) < std::max(17, o.min_inliers)) return result;
 
-  // OpenGV wants camera-frame bearings and the rig's extrinsics.
-  opengv::bearingVectors_t b1, b2;
-  std::vector<int> cam1, cam2;
-  for (int i : v.index) {
-    b1.push_back(matches[i].bearing1.normalized());
-    b2.push_back(matches[i].bearing2.normalized());
-    cam1.push_back(matches[i].camera1);
-    cam2.push_back(matches[i].camera2);
+  int hypotheses = 0;
+  SE3 T;
+  if (generalizedRansac(ws.rays, o, ws.sample_mask, T, result.ransac_iterations)) {
+    refineHypothesis(ws.rays, T, false, o, ws.scratch_mask, ws.hypotheses[hypotheses++]);
+    SE3 all;
+    if (allInlierHypothesis(T, o, ws, all))
+      refineHypothesis(ws.rays, all, false, o, ws.scratch_mask, ws.hypotheses[hypotheses++]);
   }
-  opengv::translations_t offsets;
-  opengv::rotations_t rotations;
-  for (const RigCamera& c : rig.cameras) {
-    offsets.push_back(c.T_b_c.t);
-    rotations.push_back(c.T_b_c.R);
-  }
-  opengv::relative_pose::NoncentralRelativeAdapter adapter(b1, b2, cam1, cam2, offsets, rotations);
-  using Problem = opengv::sac_problems::relative_pose::NoncentralRelativePoseSacProblem;
-  opengv::sac::Ransac<SeededProblem<Problem>> ransac;
-  ransac.sac_model_ = std::make_shared<SeededProblem<Problem>>(o.seed, adapter, Problem::SEVENTEENPT, false, false);
-  ransac.threshold_ = openGvThreshold(o);
-  ransac.max_iterations_ = o.max_iterations;
-  ransac.probability_ = o.confidence;
-  std::vector<Refined> refined;
-  if (ransac.computeModel() && static_cast<int>(ransac.inliers_.size()) >= 17) {
-    const opengv::transformation_t& M = ransac.model_coefficients_;
-    refined.push_back(refineHypothesis(v, SE3(M.leftCols<3>(), M.col(3)), false, o));
-    // The linear solver on all its inliers is far less noisy than on 17 points.
-    const opengv::transformation_t all = opengv::relative_pose::seventeenpt(adapter, ransac.inliers_);
-    refined.push_back(refineHypothesis(v, SE3(all.leftCols<3>(), all.col(3)), false, o));
-  }
-  result.ransac_iterations = ransac.iterations_;
   SE3 rotation_first;
-  if (rotationFirstHypothesis(rig, matches, v, o, rotation_first, result.ransac_iterations)) {
-    refined.push_back(refineHypothesis(v, rotation_first, false, o));
+  if (rotationFirstHypothesis(rig, matches, o, ws, rotation_first, result.ransac_iterations)) {
+    refineHypothesis(ws.rays, rotation_first, false, o, ws.scratch_mask, ws.hypotheses[hypotheses++]);
   }
-  if (refined.empty()) {
+  if (hypotheses == 0) {
     result.status = RelativePoseStatus::NoConsensus;
     return result;
   }
-  const Refined* best = &refined[0];
-  for (const Refined& r : refined) best = better(r, *best) ? &r : best;
-  finish(v, *best, false, o, matches.size(), result);
+  const Refined* best = &ws.hypotheses[0];
+  for (int h = 1; h < hypotheses; ++h) best = better(ws.hypotheses[h], *best) ? &ws.hypotheses[h] : best;
+  finish(ws, *best, false, o, matches.size());
   return result;
 }
 
-RelativePoseResult estimateCentralRelativePose(std::span<const RelativeCorrespondence> matches,
-                                               const RelativePoseOptions& o) {
-  RelativePoseResult result;
-  result.inlier_mask.assign(matches.size(), 0);
-  const Valid v = validMatches(matches, nullptr);
-  if (static_cast<int>(v.rays.size()) < std::max(8, o.min_inliers)) return result;
+const RelativePoseResult& RelativePoseEstimator::central(std::span<const RelativeCorrespondence> matches,
+                                                         const RelativePoseOptions& o) {
+  Workspace& ws = *ws_;
+  RelativePoseResult& result = ws.result;
+  clearResult(result, matches.size(), ws.capacity);
+  validMatches(matches, nullptr, ws);
+  if (static_cast<int>(ws.rays.size()) < std::max(8, o.min_inliers)) return result;
 
   SE3 T;
-  if (!centralRansac(v.rays, o, T, result.ransac_iterations)) {
+  if (!centralRansac(ws.rays, o, T, result.ransac_iterations)) {
     result.status = RelativePoseStatus::NoConsensus;
     return result;
   }
-  finish(v, refineHypothesis(v, T, true, o), true, o, matches.size(), result);
+  refineHypothesis(ws.rays, T, true, o, ws.scratch_mask, ws.hypotheses[0]);
+  finish(ws, ws.hypotheses[0], true, o, matches.size());
   return result;
+}
+
+RelativePoseResult estimateGeneralizedRelativePose(const Rig& rig, std::span<const RelativeCorrespondence> matches,
+                                                   const RelativePoseOptions& options) {
+  RelativePoseEstimator estimator(static_cast<int>(matches.size()), rig.size());
+  return estimator.generalized(rig, matches, options);
+}
+
+RelativePoseResult estimateCentralRelativePose(std::span<const RelativeCorrespondence> matches,
+                                               const RelativePoseOptions& options) {
+  RelativePoseEstimator estimator(static_cast<int>(matches.size()), 1);
+  return estimator.central(matches, options);
 }
 
 }  // namespace mcslam

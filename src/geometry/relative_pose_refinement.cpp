@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "mcslam/backend/levenberg_marquardt.hpp"
@@ -12,6 +13,10 @@ namespace mcslam::relative_pose_detail {
 namespace {
 
 using Row6 = Eigen::Matrix<double, 1, 6>;
+// At most six parameters: dynamic sizes in fixed storage, so that nothing here allocates.
+using MatUpTo6 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+using VecUpTo6 = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+using RowUpTo6 = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, 6>;
 
 // Two unit vectors orthogonal to t (columns): the tangent of the unit sphere at t.
 Eigen::Matrix<double, 3, 2> tangentBasis(const Vec3& t) {
@@ -37,7 +42,7 @@ double cost(std::span<const RayPair> matches, std::span<const uint8_t> mask, con
 }
 
 // Parameters of the solved pose: with a fixed scale, t moves on its sphere (2 parameters).
-SE3 applyStep(const SE3& T, const Eigen::VectorXd& step, bool fixed_scale, const Eigen::Matrix<double, 3, 2>& B) {
+SE3 applyStep(const SE3& T, const VecUpTo6& step, bool fixed_scale, const Eigen::Matrix<double, 3, 2>& B) {
   SE3 out = T;
   if (fixed_scale) {
     out.t = (T.t + B * step.head<2>()).normalized() * T.t.norm();
@@ -102,13 +107,13 @@ class RelativePoseProblem final : public backend::LeastSquaresProblem {
   }
   bool linearize() override {
     B_ = tangentBasis(T_.t);
-    H_ = Eigen::MatrixXd::Zero(dim_, dim_);
-    g_ = Eigen::VectorXd::Zero(dim_);
+    H_ = MatUpTo6::Zero(dim_, dim_);
+    g_ = VecUpTo6::Zero(dim_);
     for (size_t i = 0; i < matches_.size(); ++i) {
       if (!mask_[i]) continue;
       Row6 J6;
       const double e = fullJacobian(matches_[i], T_, J6);
-      Eigen::RowVectorXd J(dim_);
+      RowUpTo6 J(dim_);
       if (central_) {
         J << J6.leftCols<3>() * B_, J6.rightCols<3>();
       } else {
@@ -147,8 +152,8 @@ class RelativePoseProblem final : public backend::LeastSquaresProblem {
   const double k_;
   double c_ = 0, trial_cost_ = 0;
   Eigen::Matrix<double, 3, 2> B_;
-  Eigen::MatrixXd H_, A_;
-  Eigen::VectorXd g_, step_;
+  MatUpTo6 H_, A_;
+  VecUpTo6 g_, step_;
   SE3 candidate_;
 };
 
@@ -194,33 +199,41 @@ SE3 refineRelativePose(std::span<const RayPair> matches, std::span<const uint8_t
   return T;
 }
 
-int selectInliers(std::span<const RayPair> matches, const SE3& T, double max_angle_rad, std::vector<uint8_t>& mask) {
-  mask.assign(matches.size(), 0);
+bool isInlier(const RayPair& m, const SE3& T, double max_angle_rad) {
+  if (!(std::abs(sampsonError(m, T)) < max_angle_rad)) return false;
+  // Midpoint triangulation in frame 1: both depths must be positive, unless the rays are too close to parallel
+  // for the sign to mean anything.
+  const Vec3 d2 = T.R * m.d2;
+  const Vec3 w = T.R * m.c2 + T.t - m.c1;
+  const double b = m.d1.dot(d2);
+  if (1.0 - b * b > 4.0 * max_angle_rad * max_angle_rad) {
+    const double l2 = (d2.dot(w) - b * m.d1.dot(w)) / (b * b - 1.0);
+    const double l1 = m.d1.dot(w) + b * l2;
+    if (!(l1 > 0 && l2 > 0)) return false;
+  }
+  return true;
+}
+
+int selectInliers(std::span<const RayPair> matches, const SE3& T, double max_angle_rad, std::span<uint8_t> mask) {
   int count = 0;
   for (size_t i = 0; i < matches.size(); ++i) {
-    const RayPair& m = matches[i];
-    if (!(std::abs(sampsonError(m, T)) < max_angle_rad)) continue;
-    // Midpoint triangulation in frame 1: both depths must be positive, unless the rays are too
-    // close to parallel for the sign to mean anything.
-    const Vec3 d2 = T.R * m.d2;
-    const Vec3 w = T.R * m.c2 + T.t - m.c1;
-    const double b = m.d1.dot(d2);
-    if (1.0 - b * b > 4.0 * max_angle_rad * max_angle_rad) {
-      const double l2 = (d2.dot(w) - b * m.d1.dot(w)) / (b * b - 1.0);
-      const double l1 = m.d1.dot(w) + b * l2;
-      if (!(l1 > 0 && l2 > 0)) continue;
-    }
-    mask[i] = 1;
-    ++count;
+    mask[i] = isInlier(matches[i], T, max_angle_rad) ? 1 : 0;
+    count += mask[i];
   }
   return count;
 }
 
+int countInliers(std::span<const RayPair> matches, const SE3& T, double max_angle_rad) {
+  int count = 0;
+  for (const RayPair& m : matches) count += isInlier(m, T, max_angle_rad) ? 1 : 0;
+  return count;
+}
+
 Observability analyzeObservability(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& T,
-                                   bool central, double bearing_sigma_rad) {
+                                   bool central, double bearing_sigma_rad, std::span<double> scratch) {
   Observability out;
   Mat6 H = Mat6::Zero();
-  std::vector<double> parallax;
+  std::size_t parallax_count = 0;
   const double inv_var = 1.0 / (bearing_sigma_rad * bearing_sigma_rad);
   for (size_t i = 0; i < matches.size(); ++i) {
     if (!mask[i]) continue;
@@ -228,9 +241,10 @@ Observability analyzeObservability(std::span<const RayPair> matches, std::span<c
     sampsonError(consistentRays(matches[i], T), T, &J);
     H.noalias() += inv_var * J.transpose() * J;
     const Vec3 d2 = T.R * matches[i].d2;
-    parallax.push_back(std::atan2(matches[i].d1.cross(d2).norm(), matches[i].d1.dot(d2)));
+    scratch[parallax_count++] = std::atan2(matches[i].d1.cross(d2).norm(), matches[i].d1.dot(d2));
   }
-  if (!parallax.empty()) {
+  if (parallax_count > 0) {
+    const auto parallax = scratch.first(parallax_count);
     std::nth_element(parallax.begin(), parallax.begin() + parallax.size() / 2, parallax.end());
     out.median_parallax_rad = parallax[parallax.size() / 2];
   }
@@ -245,41 +259,41 @@ Observability analyzeObservability(std::span<const RayPair> matches, std::span<c
   const Mat6 Hq = Q.transpose() * H * Q;
   // Marginal information of a block = its Schur complement: the other parameters are free.
   // A (numerically) singular remainder means that block is not observable either: infinite sigma.
-  auto marginalCovariance = [](const Eigen::MatrixXd& Hm, int first, int size, Eigen::MatrixXd& cov) {
+  auto marginalCovariance = [](const MatUpTo6& Hm, int first, int size, MatUpTo6& cov) {
     const int n = static_cast<int>(Hm.rows());
-    std::vector<int> keep, rest;
-    for (int i = 0; i < n; ++i) (i >= first && i < first + size ? keep : rest).push_back(i);
-    Eigen::MatrixXd Hkk(size, size), Hkr(size, n - size), Hrr(n - size, n - size);
+    std::array<int, 6> keep{}, rest{};
+    int kept = 0, others = 0;
+    for (int i = 0; i < n; ++i) (i >= first && i < first + size ? keep[kept++] : rest[others++]) = i;
+    MatUpTo6 Hkk(size, size), Hkr(size, n - size), Hrr(n - size, n - size);
     for (int a = 0; a < size; ++a) {
       for (int b = 0; b < size; ++b) Hkk(a, b) = Hm(keep[a], keep[b]);
       for (int b = 0; b < n - size; ++b) Hkr(a, b) = Hm(keep[a], rest[b]);
     }
     for (int a = 0; a < n - size; ++a)
       for (int b = 0; b < n - size; ++b) Hrr(a, b) = Hm(rest[a], rest[b]);
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(Hrr);
+    Eigen::SelfAdjointEigenSolver<MatUpTo6> er(Hrr);
     const double max_ev = std::max(er.eigenvalues().maxCoeff(), Hkk.diagonal().maxCoeff());
     if (!(er.eigenvalues().minCoeff() > 1e-10 * max_ev)) return false;
-    const Eigen::MatrixXd S = Hkk - Hkr * er.eigenvectors() * er.eigenvalues().cwiseInverse().asDiagonal() *
-                                        er.eigenvectors().transpose() * Hkr.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(S);
+    const MatUpTo6 S = Hkk - Hkr * er.eigenvectors() * er.eigenvalues().cwiseInverse().asDiagonal() *
+                                 er.eigenvectors().transpose() * Hkr.transpose();
+    Eigen::SelfAdjointEigenSolver<MatUpTo6> es(S);
     if (!(es.eigenvalues().minCoeff() > 1e-10 * max_ev)) return false;
     cov = es.eigenvectors() * es.eigenvalues().cwiseInverse().asDiagonal() * es.eigenvectors().transpose();
     return true;
   };
-  Eigen::MatrixXd cov;
+  MatUpTo6 cov;
   if (central) {
     // Unit translation: only the direction and the rotation are parameters.
-    const Eigen::MatrixXd H5 = Hq.bottomRightCorner<5, 5>();
+    const MatUpTo6 H5 = Hq.bottomRightCorner<5, 5>();
     if (marginalCovariance(H5, 0, 2, cov)) {
-      out.direction_sigma_rad = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(cov).eigenvalues().maxCoeff());
+      out.direction_sigma_rad = std::sqrt(Eigen::SelfAdjointEigenSolver<MatUpTo6>(cov).eigenvalues().maxCoeff());
     }
     return out;
   }
-  const Eigen::MatrixXd H6 = Hq;
+  const MatUpTo6 H6 = Hq;
   if (marginalCovariance(H6, 0, 1, cov)) out.relative_scale_sigma = std::sqrt(cov(0, 0)) / tn;
   if (marginalCovariance(H6, 1, 2, cov)) {
-    out.direction_sigma_rad =
-        std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(cov).eigenvalues().maxCoeff()) / tn;
+    out.direction_sigma_rad = std::sqrt(Eigen::SelfAdjointEigenSolver<MatUpTo6>(cov).eigenvalues().maxCoeff()) / tn;
   }
   return out;
 }

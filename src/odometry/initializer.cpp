@@ -7,9 +7,11 @@
 namespace mcslam {
 
 Initializer::Initializer(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
-    : rig_(rig), options_(options) {
+    : rig_(rig), options_(options), estimator_(rig.size() * max_features_per_camera, rig.size()) {
   reference_.allocate(rig.size(), max_features_per_camera);
   correspondences_.reserve(static_cast<std::size_t>(rig.size()) * max_features_per_camera);
+  camera_matches_.reserve(static_cast<std::size_t>(max_features_per_camera));
+  best_camera_.inlier_mask.reserve(static_cast<std::size_t>(max_features_per_camera));
   best_of_ref_.resize(max_features_per_camera);
 }
 
@@ -100,18 +102,14 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
   }
   if (rig_.cameras() > 1 && f.mv_count == 0 && reference_.mv_count == 0) {
     last_metric_ = false;
-    const RelativePoseResult r = upToScale(frame_index, T_ref_cur);
+    const RelativePoseResult& r = upToScale(frame_index, T_ref_cur);
     last_status_ = r.status;
     return r.ok() ? TwoFrame::Ready : TwoFrame::Waiting;
   }
   last_metric_ = rig_.cameras() > 1;
   const RelativePoseOptions ro = relativePoseOptions(frame_index);
-  RelativePoseResult r;
-  if (rig_.cameras() == 1) {
-    r = estimateCentralRelativePose(correspondences_, ro);
-  } else {
-    r = estimateGeneralizedRelativePose(rig_.rig(), correspondences_, ro);
-  }
+  const RelativePoseResult& r = rig_.cameras() == 1 ? estimator_.central(correspondences_, ro)
+                                                    : estimator_.generalized(rig_.rig(), correspondences_, ro);
   last_status_ = r.status;
   if (!r.ok()) return TwoFrame::Waiting;
   if (rig_.cameras() == 1) {
@@ -124,9 +122,9 @@ Initializer::TwoFrame Initializer::feed(const FrameFeatures& f, uint64_t frame_i
   return TwoFrame::Ready;
 }
 
-RelativePoseResult Initializer::upToScale(uint64_t frame_index, SE3& T_ref_cur) {
+const RelativePoseResult& Initializer::upToScale(uint64_t frame_index, SE3& T_ref_cur) {
   const RelativePoseOptions ro = relativePoseOptions(frame_index);
-  RelativePoseResult best;
+  RelativePoseResult& best = best_camera_;
   int best_cam = -1;
   for (int c = 0; c < rig_.cameras(); ++c) {
     camera_matches_.clear();
@@ -134,12 +132,12 @@ RelativePoseResult Initializer::upToScale(uint64_t frame_index, SE3& T_ref_cur) 
       if (m.camera1 == c) camera_matches_.push_back(m);
     }
     if (static_cast<int>(camera_matches_.size()) < ro.min_inliers) continue;
-    RelativePoseResult r = estimateCentralRelativePose(camera_matches_, ro);
+    const RelativePoseResult& r = estimator_.central(camera_matches_, ro);
     // A camera with a sound pose beats one without; then the most inliers.
     const bool better =
         best_cam < 0 || (r.ok() && !best.ok()) || (r.ok() == best.ok() && r.num_inliers > best.num_inliers);
     if (better) {
-      best = std::move(r);
+      best = r;  // within the capacity reserved: no allocation
       best_cam = c;
     }
   }

@@ -213,7 +213,14 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
   const double stop_s = std::chrono::duration<double>(Clock::now() - t0).count();
   const std::string log = readAll(dir.file("log.txt"));
   EXPECT_EQ(status, 0) << log;
-  EXPECT_LT(stop_s, 2.0) << "the issue's bound from SIGTERM to exit";  // the one timed assertion (issue mcslamd)
+  // The one timed assertion (the mcslamd issue's bound from SIGTERM to exit), for the product's build: under a
+  // sanitizer every step is several times slower (2.13 s under ASan at load 6), so the bound there is 5x.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  constexpr double kStopBoundS = 10.0;
+#else
+  constexpr double kStopBoundS = 2.0;
+#endif
+  EXPECT_LT(stop_s, kStopBoundS) << "the issue's bound from SIGTERM to exit";
   EXPECT_FALSE(reader.writerRunning());
   EXPECT_EQ(notify.count("STOPPING=1"), 1);
   EXPECT_NE(log.find("SIGTERM: stopping"), std::string::npos) << log;

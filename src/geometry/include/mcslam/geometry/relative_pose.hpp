@@ -1,16 +1,14 @@
 #pragma once
-// Relative pose between two rig frames, for map initialization (paper IV-B, eq. 4).
+// Relative pose between two rig frames, for map initialization (paper IV-B, eq. 4). In fixed memory: a
+// RelativePoseEstimator sizes its buffers at construction, so that a rig that loses tracking after the warm-up can
+// start a new map without allocating.
 //
-// THIS RUNS RARELY AND ALLOCATES: it uses OpenGV's adapters, sample-consensus problems and
-// minimal solvers (std::vector everywhere). Never call it on the per-frame path.
-//
-//  - Generalized (a rig of cameras with distinct centres): the 17-point linear solver (Li, Hartley,
-//    Kim 2008, OpenGV's seventeenpt) in RANSAC, re-solved on all its inliers; plus, when matches stay
-//    within cameras, a rotation-first hypothesis (5-point in the best-covered camera, then the scale
-//    most matches agree with), which is where the 17-point solver is weakest. The best refined
-//    hypothesis wins. The translation is METRIC.
-//  - Central (one camera): the 5-point solver (Nister, OpenGV's fivept_nister) in RANSAC; the
-//    translation has UNIT NORM (its scale is not observable) and the pose is that of the camera.
+//  - Generalized (a rig of cameras with distinct centres): the linear 17-point solver (Li, Hartley, Kim 2008) in
+//    RANSAC, re-solved on all its inliers; plus, when matches stay within cameras, a rotation-first hypothesis
+//    (5-point in the best-covered camera, then the scale most matches agree with), which is where the 17-point
+//    solver is weakest. The best refined hypothesis wins. The translation is METRIC.
+//  - Central (one camera): the 5-point solver (Stewenius' form of Nister's problem) in RANSAC; the translation has
+//    UNIT NORM (its scale is not observable) and the pose is that of the camera.
 // Both are then refined by Levenberg-Marquardt on the generalized epipolar error (eq. 4) divided
 // by its first-order standard deviation (a Sampson error, in radians), Huber loss, and inliers
 // are re-selected (including: the point triangulates in front of both cameras).
@@ -22,6 +20,7 @@
 // then waits for better frames.
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -68,7 +67,7 @@ struct RelativePoseResult {
   // Central: camera frames, |t| = 1.
   SE3 T_1_2;
   bool metric = false;
-  std::vector<uint8_t> inlier_mask;  // one per correspondence
+  std::vector<uint8_t> inlier_mask;  // one per correspondence (up to the estimator's capacity)
   int num_inliers = 0;
   int ransac_iterations = 0;
   double relative_scale_sigma = INFINITY;  // sigma(|t|) / |t| (generalized), infinite for central
@@ -77,13 +76,33 @@ struct RelativePoseResult {
   bool ok() const { return status == RelativePoseStatus::Ok; }
 };
 
-// Generalized relative pose of the rig between two frames (metric). A rig of one camera has no
-// metric scale: ScaleUnobservable (use estimateCentralRelativePose).
+// Owns every buffer of the estimation, sized for `max_correspondences` matches of a rig of up to `max_cameras`
+// cameras: after construction it allocates nothing. Matches beyond the capacity are left out.
+class RelativePoseEstimator {
+ public:
+  RelativePoseEstimator(int max_correspondences, int max_cameras);
+  ~RelativePoseEstimator();
+  RelativePoseEstimator(RelativePoseEstimator&&) noexcept;
+  RelativePoseEstimator& operator=(RelativePoseEstimator&&) noexcept;
+
+  // Generalized relative pose of the rig between two frames (metric). A rig of one camera has no metric scale:
+  // ScaleUnobservable (use central()). The result stays valid until the next call.
+  const RelativePoseResult& generalized(const Rig& rig, std::span<const RelativeCorrespondence> matches,
+                                        const RelativePoseOptions& options = {});
+  // Central relative pose of one camera between two frames (camera indices are ignored; bearings in the camera
+  // frame). Unit translation.
+  const RelativePoseResult& central(std::span<const RelativeCorrespondence> matches,
+                                    const RelativePoseOptions& options = {});
+
+  struct Workspace;  // relative_pose.cpp
+
+ private:
+  std::unique_ptr<Workspace> ws_;
+};
+
+// One-off estimations (tests, tools): an estimator sized for these matches.
 RelativePoseResult estimateGeneralizedRelativePose(const Rig& rig, std::span<const RelativeCorrespondence> matches,
                                                    const RelativePoseOptions& options = {});
-
-// Central relative pose of one camera between two frames (camera indices are ignored; bearings
-// in the camera frame). Unit translation.
 RelativePoseResult estimateCentralRelativePose(std::span<const RelativeCorrespondence> matches,
                                                const RelativePoseOptions& options = {});
 

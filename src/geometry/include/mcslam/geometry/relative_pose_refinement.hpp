@@ -1,9 +1,8 @@
 #pragma once
 // The parts of the relative pose that are ours (relative_pose.cpp uses them; public for the tests):
 // refinement, inlier selection and observability on matched rays, with the generalized epipolar
-// constraint (paper eq. 4). Allocates (initialization only).
+// constraint (paper eq. 4). In fixed memory: the caller owns every buffer.
 #include <span>
-#include <vector>
 
 #include "mcslam/geometry/relative_pose.hpp"
 
@@ -27,8 +26,11 @@ double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1,
 SE3 refineRelativePose(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& T_1_2,
                        bool fixed_scale, const RelativePoseOptions& options);
 
-// Marks the matches within the angle threshold whose point triangulates in front of both cameras.
-int selectInliers(std::span<const RayPair> matches, const SE3& T_1_2, double max_angle_rad, std::vector<uint8_t>& mask);
+// Whether the match is within the angle threshold and its point triangulates in front of both cameras.
+bool isInlier(const RayPair& match, const SE3& T_1_2, double max_angle_rad);
+// Marks the inliers (mask: one per match) and counts them.
+int selectInliers(std::span<const RayPair> matches, const SE3& T_1_2, double max_angle_rad, std::span<uint8_t> mask);
+int countInliers(std::span<const RayPair> matches, const SE3& T_1_2, double max_angle_rad);
 
 struct Observability {
   double relative_scale_sigma = INFINITY;
@@ -37,8 +39,8 @@ struct Observability {
 };
 
 // Uncertainty of the translation (metric scale and direction) from the information matrix of the
-// inliers at T_1_2, with bearing noise sigma; and the median rotation-compensated parallax.
+// inliers at T_1_2, with bearing noise sigma; and the median rotation-compensated parallax (scratch: one per match).
 Observability analyzeObservability(std::span<const RayPair> matches, std::span<const uint8_t> mask, const SE3& T_1_2,
-                                   bool central, double bearing_sigma_rad);
+                                   bool central, double bearing_sigma_rad, std::span<double> scratch);
 
 }  // namespace mcslam::relative_pose_detail

@@ -5,7 +5,8 @@
 // observability check. Two frames of a rig without overlap (no multi-view feature in either) cannot
 // observe the metric scale with lever arms of centimetres: such a rig starts up to scale, from the
 // 5-point pose of its best camera, and the odometry estimates the scale later over the back-end's
-// window (ScaleEstimator). The two-frame path runs rarely and may allocate.
+// window (ScaleEstimator). Like the rest of the frame's path, it allocates nothing after construction: a rig
+// that lost tracking for good starts a new map through it.
 #include <vector>
 
 #include "mcslam/features/frame_features.hpp"
@@ -57,8 +58,10 @@ class Initializer {
   std::vector<RelativeCorrespondence> correspondences_;
   std::vector<int32_t> best_of_ref_;
   // Up to scale from the one camera whose 5-point pose has the most inliers (rig without overlap).
-  RelativePoseResult upToScale(uint64_t frame_index, SE3& T_ref_cur);
+  const RelativePoseResult& upToScale(uint64_t frame_index, SE3& T_ref_cur);
 
+  RelativePoseEstimator estimator_;
+  RelativePoseResult best_camera_;                      // upToScale's best camera so far (capacity reserved)
   std::vector<RelativeCorrespondence> camera_matches_;  // one camera's share of correspondences_
   bool last_metric_ = true;
   RelativePoseStatus last_status_ = RelativePoseStatus::TooFewCorrespondences;
