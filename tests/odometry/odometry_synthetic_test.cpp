@@ -207,10 +207,8 @@ double unitBetween(const test::SyntheticSequence& seq, const Trajectory& estimat
 // nearer were kept, and each corner (where the map is rebuilt from short baselines) shrank the unit by 20-35%:
 // about 0.18x its first value after two loops, Sim(3) ATE 3.1 m. Judged against the scene's inverse depth: the
 // last straight's unit is 0.82x the first's, ATE 0.65 m (Triangulation.SceneReferenceKeepsTheInverseDepthUnbiased
-// shows the mechanism). Since the initialization has its own five-point solver it starts at frame 8 on the true
-// forward motion (it took frame 2 on a direction 48 deg off before): the unit ratio is 1.04, ATE 1.02 m, and the rig
-// loses its map for the last 6 frames, turning in the final corner with too little parallax for new points
-// (BENCHMARKS.md, section 5, "Relative pose"): at most 1% of the frames lost.
+// shows the mechanism). Turning in the final corner, one camera finds too little parallax for new points and may
+// lose its map for a few frames: at most 1% of them (BENCHMARKS.md, section 5, "Relative pose").
 TEST(OdometrySynthetic, OneCameraKeepsItsUnitAroundCorners) {
   test::SyntheticSequenceOptions so;
   so.rounded_rectangle = true;

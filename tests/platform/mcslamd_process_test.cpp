@@ -214,7 +214,7 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
   const std::string log = readAll(dir.file("log.txt"));
   EXPECT_EQ(status, 0) << log;
   // The one timed assertion (the mcslamd issue's bound from SIGTERM to exit), for the product's build: under a
-  // sanitizer every step is several times slower (2.13 s under ASan at load 6), so the bound there is 5x.
+  // sanitizer every step is several times slower, so the bound there is 5x.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
   constexpr double kStopBoundS = 10.0;
 #else
