@@ -10,8 +10,9 @@ Initializer::Initializer(const Rig& rig, const OdometryOptions& options, int max
     : rig_(rig), options_(options), estimator_(rig.size() * max_features_per_camera, rig.size()) {
   reference_.allocate(rig.size(), max_features_per_camera);
   correspondences_.reserve(static_cast<std::size_t>(rig.size()) * max_features_per_camera);
-  camera_matches_.reserve(static_cast<std::size_t>(max_features_per_camera));
-  best_camera_.inlier_mask.reserve(static_cast<std::size_t>(max_features_per_camera));
+  // As many as correspondences_ (one camera's share cannot exceed them): no allocation whatever the split.
+  camera_matches_.reserve(correspondences_.capacity());
+  best_camera_.inlier_mask.reserve(correspondences_.capacity());
   best_of_ref_.resize(max_features_per_camera);
 }
 

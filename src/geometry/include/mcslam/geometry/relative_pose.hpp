@@ -6,7 +6,9 @@
 //  - Generalized (a rig of cameras with distinct centres): the linear 17-point solver (Li, Hartley, Kim 2008) in
 //    RANSAC, re-solved on all its inliers; plus, when matches stay within cameras, a rotation-first hypothesis
 //    (5-point in the best-covered camera, then the scale most matches agree with), which is where the 17-point
-//    solver is weakest. The best refined hypothesis wins. The translation is METRIC.
+//    solver is weakest. The best refined hypothesis wins. The translation is METRIC. An axial rig (all camera
+//    centres on one line, e.g. a stereo pair) with matches only ACROSS its cameras is degenerate for the linear
+//    solver (a family of false essential matrices): no pose, the status says so. Within cameras it is not.
 //  - Central (one camera): the 5-point solver (Stewenius' form of Nister's problem) in RANSAC; the translation has
 //    UNIT NORM (its scale is not observable) and the pose is that of the camera.
 // Both are then refined by Levenberg-Marquardt on the generalized epipolar error (eq. 4) divided
