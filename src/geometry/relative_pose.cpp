@@ -289,16 +289,12 @@ bool allInlierHypothesis(const SE3& ransac_pose, const RelativePoseOptions& o, W
   return true;
 }
 
+// The struct's defaults, keeping the mask's reserved storage.
 void clearResult(RelativePoseResult& result, std::size_t matches, std::size_t capacity) {
+  std::vector<uint8_t> mask = std::move(result.inlier_mask);
+  result = RelativePoseResult{};
+  result.inlier_mask = std::move(mask);
   result.inlier_mask.assign(std::min(matches, capacity), 0);
-  result.status = RelativePoseStatus::TooFewCorrespondences;
-  result.T_1_2 = SE3();
-  result.metric = false;
-  result.num_inliers = 0;
-  result.ransac_iterations = 0;
-  result.relative_scale_sigma = INFINITY;
-  result.direction_sigma_rad = INFINITY;
-  result.median_parallax_rad = 0;
 }
 
 }  // namespace

@@ -33,11 +33,6 @@ std::vector<relative_pose_detail::RayPair> bodyRays(const Rig& rig, const TwoFra
   return rays;
 }
 
-// Distance between essential matrices, which are defined up to sign (both of unit norm).
-double essentialDistance(const Mat3& a, const Mat3& b) {
-  return std::min((a.normalized() - b.normalized()).norm(), (a.normalized() + b.normalized()).norm());
-}
-
 int maskErrors(const TwoFrames& f, const std::vector<uint8_t>& mask) {
   int wrong = 0;
   for (size_t i = 0; i < mask.size(); ++i) wrong += (mask[i] != 0) != (f.is_inlier[i] != 0) ? 1 : 0;

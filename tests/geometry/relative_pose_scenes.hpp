@@ -76,4 +76,9 @@ inline SE3 motion(double yaw_deg, const Vec3& t) {
   return SE3(so3Exp(Vec3(0.1, 1.0, 0.05).normalized() * yaw_deg * M_PI / 180), t);
 }
 
+// Distance between essential matrices, which are defined up to sign (both of unit norm).
+inline double essentialDistance(const Mat3& a, const Mat3& b) {
+  return std::min((a.normalized() - b.normalized()).norm(), (a.normalized() + b.normalized()).norm());
+}
+
 }  // namespace mcslam::test

@@ -25,7 +25,7 @@ struct OdometryOptions {
   int min_tracked = 12;                 // fewer inliers after refinement: the frame is lost
   double strong_tracking_share = 0.25;  // a coarse pose is trusted with this share of the previous frame's inliers
   // A coarse pose needs this share of the matches its attempt holds as inliers: fewer is chance agreement
-  // (repeated texture, another place), not a pose (BENCHMARKS.md, "Kidnap").
+  // (repeated texture, another place), not a pose.
   double min_consensus_share = 0.1;
 
   // Tracking loss: the map is dropped and a new one started once this many frames in a row failed and, when place
