@@ -138,7 +138,7 @@ int runDaemon(const DaemonConfig& config) {
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
   SystemdNotifier notifier;
-  Daemon daemon(config, createPipeline(config.slam, config.file, config.rig));
+  Daemon daemon(config, createPipeline(config.slam, config.file, config.rig, /*live=*/true));
   daemon.start();
   notifier.ready();
   spdlog::info("mcslamd: running ({} cameras, source {}, trigger {}, trajectory {}){}", config.rig.size(),

@@ -49,6 +49,11 @@ void WorkerPool::wait() {
   job_ = nullptr;
 }
 
+bool WorkerPool::idle() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return active_ == 0;
+}
+
 void WorkerPool::run(PoolJob& job, int tasks) {
   submit(job, tasks);
   if (tasks <= 0 || workers_.empty()) return;

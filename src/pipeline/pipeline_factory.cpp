@@ -12,8 +12,11 @@ std::string effectivePipelineConfig(const YAML::Node& slam, const std::string& s
   return formatPipelineConfig(parsePipelineConfig(slam, source, rig));
 }
 
-std::unique_ptr<FrameProcessor> createPipeline(const YAML::Node& slam, const std::string& source, const Rig& rig) {
-  return std::make_unique<SlamPipeline>(rig, parsePipelineConfig(slam, source, rig));
+std::unique_ptr<FrameProcessor> createPipeline(const YAML::Node& slam, const std::string& source, const Rig& rig,
+                                               bool live) {
+  PipelineConfig config = parsePipelineConfig(slam, source, rig);
+  config.places.wait_for_correction = !live;
+  return std::make_unique<SlamPipeline>(rig, config);
 }
 
 }  // namespace mcslam

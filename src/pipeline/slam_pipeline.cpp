@@ -99,6 +99,15 @@ void SlamPipeline::process(const RigFrameView& frame, PoseEstimate& out) {
   timing_.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+void SlamPipeline::flush() {
+  odometry_.flush();
+  if (places_) places_->flush();
+}
+
+uint64_t SlamPipeline::backgroundThreadAllocations() const {
+  return odometry_.backendThreadAllocations() + (places_ ? places_->threadAllocations() : 0);
+}
+
 void SlamPipeline::loadMap(const std::string& path, bool localize_only) {
   if (!places_) throw InputError(path + ": a map needs place memory, which places.enabled turns off");
   places_->readMap(readFileBounded(path, kMaxMapFileBytes, "map file"), path, localize_only);

@@ -2,27 +2,11 @@
 
 #include <spdlog/spdlog.h>
 
-#include <chrono>
 #include <cmath>
 
 #include "pose_io.hpp"
 
 namespace mcslam {
-
-namespace {
-
-// The odometry's relative pose between consecutive keyframes: about 1% of the distance and of the angle, plus a
-// floor (a keyframe pair that hardly moved is still only known to a few millimetres and a tenth of a degree).
-Vec6 odometrySigma(const SE3& T_a_b) {
-  const double d = T_a_b.t.norm();
-  const double angle = so3Log(T_a_b.R).norm();
-  Vec6 s;
-  s.head<3>().setConstant(0.005 + 0.01 * d);
-  s.tail<3>().setConstant(0.002 + 0.01 * angle + 0.001 * d);
-  return s;
-}
-
-}  // namespace
 
 int32_t LoopCloser::findRoot(int32_t s) {
   std::vector<int32_t>& root = segment_root_;
@@ -34,15 +18,15 @@ int32_t LoopCloser::findRoot(int32_t s) {
 LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera)
     : options_(options),
       verifier_(rig, options, scale_factor, max_features_per_camera),
-      graph_(options.max_keyframes, 2 * options.max_keyframes + options.max_loops),
       loops_(static_cast<std::size_t>(options.max_loops)),
-      node_of_slot_(static_cast<std::size_t>(options.max_keyframes), -1),
-      slot_of_node_(static_cast<std::size_t>(options.max_keyframes), -1),
-      segment_root_(PlaceMap::kMaxSegments) {
+      segment_root_(PlaceMap::kMaxSegments),
+      roots_(PlaceMap::kMaxSegments),
+      correction_(options.max_keyframes, options.max_loops) {
   clear();
 }
 
 void LoopCloser::clear() {
+  correction_wanted_ = false;
   loop_count_ = 0;
   for (int32_t s = 0; s < PlaceMap::kMaxSegments; ++s) segment_root_[static_cast<std::size_t>(s)] = s;
   pending_keyframe_ = -1;
@@ -50,6 +34,13 @@ void LoopCloser::clear() {
 
 bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const FrameWords& words, PlaceMap& map,
                             const PlaceDatabase& database) {
+  // While the map's correction is being solved, its poses are about to move: a detection now would be measured
+  // against the old ones (and find the loop just closed again).
+  if (correcting()) {
+    ++stats_.skipped;
+    pending_keyframe_ = -1;
+    return false;
+  }
   const PlaceKeyframe& k = map.keyframe(slot);
   const auto reachable = [&](int other) {
     const PlaceKeyframe& o = map.keyframe(other);
@@ -94,21 +85,40 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
     segment_root_[static_cast<std::size_t>(std::max(root_k, root_c))] = std::min(root_k, root_c);
     ++stats_.merges;
   }
-  const auto start = std::chrono::steady_clock::now();
-  correct(map);
-  stats_.last_solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  accepted_ = {k.id, candidate, k.t, map.keyframe(r.keyframe).t, r.inliers, correction};
+  pending_keyframe_ = -1;
+  correction_wanted_ = true;
+  startCorrection(map);
+  return true;
+}
+
+bool LoopCloser::takeCorrection(PlaceMap& map, bool wait) {
+  const LoopCorrection::Outcome outcome = correction_.take(map, wait);
+  if (outcome == LoopCorrection::Outcome::Stale) {
+    ++stats_.restarted;
+    correction_wanted_ = true;
+  }
+  if (correction_wanted_ && !correction_.running()) startCorrection(map);
+  if (outcome != LoopCorrection::Outcome::Applied) return false;
   ++stats_.closures;
-  stats_.last_keyframe = k.id;
-  stats_.last_candidate = candidate;
-  stats_.last_correction_m = correction.t.norm();
-  stats_.last_correction_deg = so3Log(correction.R).norm() * 180.0 / M_PI;
+  stats_.last_keyframe = accepted_.keyframe;
+  stats_.last_candidate = accepted_.candidate;
+  stats_.last_correction_m = accepted_.correction.t.norm();
+  stats_.last_correction_deg = so3Log(accepted_.correction.R).norm() * 180.0 / M_PI;
+  stats_.last_solve_ms = correction_.lastSolveMs();
   spdlog::info(
       "place memory: loop closed: keyframe {} (t = {:.3f} s) sees keyframe {} (t = {:.3f} s) again ({} inliers); "
       "correction {:.3f} m, {:.2f} deg; pose graph solved in {:.1f} ms",
-      k.id, toSeconds(k.t), candidate, toSeconds(map.keyframe(r.keyframe).t), r.inliers, stats_.last_correction_m,
-      stats_.last_correction_deg, stats_.last_solve_ms);
-  pending_keyframe_ = -1;
+      accepted_.keyframe, toSeconds(accepted_.t_keyframe), accepted_.candidate, toSeconds(accepted_.t_candidate),
+      accepted_.inliers, stats_.last_correction_m, stats_.last_correction_deg, stats_.last_solve_ms);
   return true;
+}
+
+void LoopCloser::startCorrection(const PlaceMap& map) {
+  const int segments = map.segments();
+  for (int32_t s = 0; s < segments; ++s) roots_[static_cast<std::size_t>(s)] = findRoot(s);
+  correction_.start(map, loopEdges(), {roots_.data(), static_cast<std::size_t>(segments)});
+  correction_wanted_ = false;
 }
 
 // A loop returns: within one segment, the path from the candidate to this keyframe must be much longer than
@@ -133,32 +143,6 @@ bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& co
     return false;
   return sameCorrection(pending_correction_, correction,
                         (k.T_w_k.t - map.keyframe(k.previous).T_w_k.t).norm() + correction.t.norm());
-}
-
-void LoopCloser::correct(PlaceMap& map) {
-  buildGraph(map);
-  graph_.optimize();
-  for (int node = 0; node < graph_.nodes(); ++node)
-    map.setKeyframePose(slot_of_node_[static_cast<std::size_t>(node)], graph_.pose(node));
-  // Each segment's odometry frame follows its newest keyframe: the odometry goes on from where the map now puts it.
-  for (int32_t s = 0; s < map.segments(); ++s) {
-    const int newest = segmentEnd(map, s, /*oldest=*/false);
-    if (newest >= 0) map.setSegmentPose(s, map.keyframe(newest).T_w_k * map.keyframe(newest).T_o_k.inverse());
-  }
-}
-
-int LoopCloser::segmentEnd(const PlaceMap& map, int32_t segment, bool oldest) const {
-  for (int slot = 0; slot < map.capacity(); ++slot) {
-    const PlaceKeyframe& k = map.keyframe(slot);
-    if (k.alive && k.segment == segment && (oldest ? k.previous : k.next) < 0) return slot;
-  }
-  return -1;
-}
-
-int LoopCloser::slotOfId(const PlaceMap& map, int64_t id) const {
-  for (int slot = 0; slot < map.capacity(); ++slot)
-    if (map.keyframe(slot).alive && map.keyframe(slot).id == id) return slot;
-  return -1;
 }
 
 constexpr std::size_t kLoopBytes = 2 * sizeof(int64_t) + 12 * sizeof(double) + 6 * sizeof(double);
@@ -207,41 +191,8 @@ void LoopCloser::write(ByteWriter& out, int segments) const {
 }
 
 void LoopCloser::read(ByteReader& in, int segments) {
-  clear();
+  clear();  // before the first frame: nothing is being solved
   loop_count_ = takeLoops(in, segments, loops_, segment_root_);
-}
-
-// Nodes: every place keyframe, in slot order. Edges: consecutive keyframes of a segment (the odometry's relative
-// pose), and the loops. Each set of segments joined by loops is held by the oldest keyframe of its root segment.
-void LoopCloser::buildGraph(const PlaceMap& map) {
-  graph_.clear();
-  std::fill(node_of_slot_.begin(), node_of_slot_.end(), -1);
-  for (int slot = 0; slot < map.capacity(); ++slot) {
-    const PlaceKeyframe& k = map.keyframe(slot);
-    if (!k.alive) continue;
-    const int node = graph_.addNode(k.T_w_k, false);
-    node_of_slot_[static_cast<std::size_t>(slot)] = node;
-    slot_of_node_[static_cast<std::size_t>(node)] = slot;
-  }
-  for (int32_t s = 0; s < map.segments(); ++s) {
-    if (findRoot(s) != s) continue;
-    const int oldest = segmentEnd(map, s, /*oldest=*/true);
-    if (oldest >= 0) graph_.setFixed(node_of_slot_[static_cast<std::size_t>(oldest)], true);
-  }
-  for (int slot = 0; slot < map.capacity(); ++slot) {
-    const PlaceKeyframe& k = map.keyframe(slot);
-    if (!k.alive || k.previous < 0) continue;
-    const SE3 T_a_b = map.keyframe(k.previous).T_o_k.inverse() * k.T_o_k;
-    graph_.addEdge(node_of_slot_[static_cast<std::size_t>(k.previous)], node_of_slot_[static_cast<std::size_t>(slot)],
-                   T_a_b, odometrySigma(T_a_b));
-  }
-  for (int i = 0; i < loop_count_; ++i) {
-    const LoopEdge& e = loops_[static_cast<std::size_t>(i)];
-    const int a = slotOfId(map, e.a), b = slotOfId(map, e.b);
-    if (a >= 0 && b >= 0)
-      graph_.addEdge(node_of_slot_[static_cast<std::size_t>(a)], node_of_slot_[static_cast<std::size_t>(b)], e.T_a_b,
-                     e.sigma);
-  }
 }
 
 }  // namespace mcslam

@@ -15,6 +15,7 @@ PlaceMap::PlaceMap(int max_keyframes, int max_points_per_keyframe)
       newest_of_segment_(kMaxSegments, -1),
       segment_T_w_o_(kMaxSegments),
       segment_placed_(kMaxSegments, 0),
+      segment_continues_(kMaxSegments, -1),
       file_position_(static_cast<std::size_t>(max_keyframes)) {
   clear();
 }
@@ -26,7 +27,9 @@ void PlaceMap::clear() {
   live_ = 0;
   newest_ = -1;
   std::fill(newest_of_segment_.begin(), newest_of_segment_.end(), -1);
+  std::fill(segment_continues_.begin(), segment_continues_.end(), -1);
   segment_count_ = 0;
+  ++reshapes_;
 }
 
 int PlaceMap::createKeyframe(int32_t segment, Timestamp t, uint64_t frame_index, const SE3& T_w_k, const SE3& T_o_k) {
@@ -124,6 +127,7 @@ int PlaceMap::leastNeededKeyframe(std::span<const int64_t> kept) const {
 }
 
 void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {
+  ++reshapes_;
   const SE3& T_w_o = segment_T_w_o_[static_cast<std::size_t>(segment)];
   for (int slot = 0; slot < capacity(); ++slot) {
     PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
@@ -135,14 +139,16 @@ void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {
   }
 }
 
-int32_t PlaceMap::createSegment(const SE3& T_w_o, bool placed) {
+int32_t PlaceMap::createSegment(const SE3& T_w_o, bool placed, int32_t continues) {
   if (segment_count_ == kMaxSegments) return -1;
   segment_T_w_o_[static_cast<std::size_t>(segment_count_)] = T_w_o;
   segment_placed_[static_cast<std::size_t>(segment_count_)] = placed ? 1 : 0;
+  segment_continues_[static_cast<std::size_t>(segment_count_)] = continues;
   return segment_count_++;
 }
 
 void PlaceMap::moveSegment(int32_t segment, const SE3& T_w_o) {
+  ++reshapes_;
   segment_T_w_o_[static_cast<std::size_t>(segment)] = T_w_o;
   for (PlaceKeyframe& k : keyframes_)
     if (k.alive && k.segment == segment) k.T_w_k = T_w_o * k.T_o_k;

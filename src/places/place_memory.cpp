@@ -29,6 +29,7 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
 
 void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry,
                                 PoseEstimate& out) {
+  takeCorrection(options_.wait_for_correction);
   followSegment(odometry);
   // Before the keyframes settled in this frame join: they are in the new unit already.
   for (const Odometry::Rescale& r : odometry.rescales()) map_.rescaleSegment(segment_, r.s, r.center);
@@ -67,7 +68,7 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
   const SE3 T_w_o = segment_ >= 0 ? map_.segmentPose(segment_) : SE3();
   // The first map of a run that reuses a saved one is nowhere in it until recognized.
   const bool placed = segment_ >= 0 ? map_.placed(segment_) : !loaded_;
-  const int32_t s = map_.createSegment(T_w_o, placed);
+  const int32_t s = map_.createSegment(T_w_o, placed, segment_);
   if (s < 0) {
     spdlog::warn("place memory: more than {} odometry maps; the newest keeps the last one's frame",
                  PlaceMap::kMaxSegments);
@@ -117,11 +118,14 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   // Sim(3), which is not built yet.
   if (options_.loop_closure && odometry.rigState().metric()) {
     loop_closer_.setRig(odometry.trackingRig());
-    if (loop_closer_.onKeyframe(slot, kf.features, words_, map_, database_)) {
-      ++world_revision_;
-      propagatePlacement();
-    }
+    loop_closer_.onKeyframe(slot, kf.features, words_, map_, database_);
   }
+}
+
+void PlaceMemory::takeCorrection(bool wait) {
+  if (!loop_closer_.takeCorrection(map_, wait)) return;
+  ++world_revision_;
+  propagatePlacement();
 }
 
 void PlaceMemory::makeRoom() {

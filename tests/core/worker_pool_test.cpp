@@ -91,6 +91,25 @@ TEST(WorkerPool, OneWorkerTakesTheTasksInIndexOrder) {
   for (int t = 0; t < 100; ++t) EXPECT_EQ(order[static_cast<std::size_t>(t)], t);
 }
 
+// idle() answers without blocking: false while a batch runs (its task holds until released), true once done.
+TEST(WorkerPool, IdleTellsWhetherABatchRuns) {
+  WorkerPool pool(1);
+  EXPECT_TRUE(pool.idle());
+  struct Held final : PoolJob {
+    std::atomic<bool> started{false}, release{false};
+    void run(int, int) override {
+      started = true;
+      while (!release) std::this_thread::yield();
+    }
+  } job;
+  pool.submit(job, 1);
+  while (!job.started) std::this_thread::yield();
+  EXPECT_FALSE(pool.idle());
+  job.release = true;
+  pool.wait();
+  EXPECT_TRUE(pool.idle());
+}
+
 // Every task waits until the task before it has started: possible only if no task is taken before the earlier
 // ones (FeatureWorkers' follow-up tasks rely on it).
 TEST(WorkerPool, ATaskMayWaitForAnEarlierTaskOfItsBatch) {

@@ -27,7 +27,7 @@ inline void expectRunAllocatedNothing(const std::string& stats) {
   ASSERT_NE(at, std::string::npos) << stats;
   const std::string part = stats.substr(at, stats.find('}', at) - at);
   EXPECT_NE(part.find("\"counted\": true"), std::string::npos) << part;
-  for (const char* zero : {"\"front_end_thread\": 0", "\"tracking_thread\": 0", "\"backend_thread\": 0"})
+  for (const char* zero : {"\"front_end_thread\": 0", "\"tracking_thread\": 0", "\"background_threads\": 0"})
     EXPECT_NE(part.find(zero), std::string::npos) << part;
 }
 

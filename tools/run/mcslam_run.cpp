@@ -210,7 +210,7 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<st
   constexpr std::size_t kWarmupFrames = 50;
   run::AllocationCount allocations{alloc::available(), kWarmupFrames};
   std::atomic<uint64_t> front_end_allocations{0};
-  uint64_t backend_at_warmup = 0;
+  uint64_t background_at_warmup = 0;
   auto prepare = [&](std::size_t i) {
     const DatasetFrame f = prefetch.take(i);
     const alloc::ThreadScope scope;
@@ -236,7 +236,7 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<st
     if (!overlap) prepare(i);
     PoseEstimate pose;
     FrameTag tag;
-    if (i == kWarmupFrames) backend_at_warmup = pipeline.backendThreadAllocations();
+    if (i == kWarmupFrames) background_at_warmup = pipeline.backgroundThreadAllocations();
     const alloc::ThreadScope scope;
     if (!runner.finish(pose, tag)) break;  // the front-end failed (rethrown below)
     if (i >= kWarmupFrames) allocations.tracking += scope.count();
@@ -260,7 +260,7 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<st
   if (front_end.joinable()) front_end.join();
   if (front_end_error) std::rethrow_exception(front_end_error);
   pipeline.flush();  // the last keyframe's back-end solve
-  if (frames > kWarmupFrames) allocations.backend = pipeline.backendThreadAllocations() - backend_at_warmup;
+  if (frames > kWarmupFrames) allocations.background = pipeline.backgroundThreadAllocations() - background_at_warmup;
   allocations.front_end = front_end_allocations;
   report.setAllocations(allocations);
   pipeline.keyframes(keyframes);

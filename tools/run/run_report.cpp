@@ -164,7 +164,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("warmup_frames").value(static_cast<unsigned long long>(allocations_.warmup_frames));
   j.key("front_end_thread").value(static_cast<unsigned long long>(allocations_.front_end));
   j.key("tracking_thread").value(static_cast<unsigned long long>(allocations_.tracking));
-  j.key("backend_thread").value(static_cast<unsigned long long>(allocations_.backend));
+  j.key("background_threads").value(static_cast<unsigned long long>(allocations_.background));
   j.endObject();
   j.key("timing_ms").beginObject();
   const std::pair<const char*, Summary> stages[] = {{"feature_extraction", summarize(features)},

@@ -29,7 +29,7 @@ struct StateChange {
 struct AllocationCount {
   bool counted = false;
   uint64_t warmup_frames = 0;
-  uint64_t front_end = 0, tracking = 0, backend = 0;
+  uint64_t front_end = 0, tracking = 0, background = 0;  // background: the back-end's and loop closer's threads
 };
 
 class RunReport {

@@ -52,6 +52,8 @@ class WorkerPool {
   void submit(PoolJob& job, int tasks);
   // Blocks until the batch submitted last has finished (at once when none runs).
   void wait();
+  // True when no batch runs (the last one finished): wait() would return at once. Does not block.
+  bool idle();
   // submit() and wait(), with the calling thread taking tasks too (as thread threads()).
   void run(PoolJob& job, int tasks);
   // run() for a callable: fn(task), or fn(task, thread).

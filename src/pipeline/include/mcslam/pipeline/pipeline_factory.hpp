@@ -20,7 +20,9 @@ void validatePipelineConfig(const YAML::Node& slam_section, const std::string& s
 // The effective configuration (defaults filled in) as YAML text, for --check-config.
 std::string effectivePipelineConfig(const YAML::Node& slam_section, const std::string& source, const Rig& rig);
 
+// `live`: a rig's frames as they come (mcslamd), where no frame waits for background work (a loop's correction
+// lands at the first frame it is ready), instead of a run that repeats exactly.
 std::unique_ptr<FrameProcessor> createPipeline(const YAML::Node& slam_section, const std::string& source,
-                                               const Rig& rig);
+                                               const Rig& rig, bool live = false);
 
 }  // namespace mcslam

@@ -33,11 +33,12 @@ class SlamPipeline final : public FrameProcessor {
   int stageSlots() const override { return static_cast<int>(stages_.size()); }
   void prepare(const RigFrameView& frame, int slot) override;
   void finish(int slot, PoseEstimate& out) override;
-  // Completes the back-end work of the last keyframe (finish() does it before the next frame): call it after
-  // the last frame, before reading the final keyframes.
-  void flush() { odometry_.flush(); }
-  // Heap allocations the back-end's thread has made so far (zero without the counting hooks).
-  uint64_t backendThreadAllocations() const { return odometry_.backendThreadAllocations(); }
+  // Completes the back-end work of the last keyframe (finish() does it before the next frame) and a loop
+  // correction still being solved: call it after the last frame, before reading the final keyframes.
+  void flush();
+  // Heap allocations the back-end's and the loop closer's threads have made so far (zero without the counting
+  // hooks).
+  uint64_t backgroundThreadAllocations() const;
 
   // Read on the thread that finishes the frames, between frames.
   const PipelineTiming& timing() const { return timing_; }  // of the last finished frame

@@ -3,14 +3,13 @@
 // then the relocalizer's verification: generalized P3P, guided search, strict acceptance), among keyframes the
 // odometry can no longer reach (of another segment, or `loop_min_keyframes_apart` keyframes older). A loop is
 // accepted when two consecutive keyframes of the segment find it with the same correction (zero false closures
-// is the rule). It then becomes an edge of the pose graph over every place keyframe (consecutive keyframes joined
-// by the odometry's relative poses), which is solved; the keyframes (and the points anchored in them) take the
-// solution, and every segment's T_w_o follows its newest keyframe. Fixed memory.
+// is the rule). It then becomes an edge of the pose graph over every place keyframe, solved on a thread of its own
+// while frames go on (LoopCorrection); at a frame boundary the map takes the solution. Fixed memory.
 #include <cstdint>
 #include <span>
 #include <vector>
 
-#include "mcslam/backend/pose_graph.hpp"
+#include "mcslam/places/loop_correction.hpp"
 #include "mcslam/places/place_map.hpp"
 #include "mcslam/places/places_options.hpp"
 #include "mcslam/places/relocalizer.hpp"
@@ -23,16 +22,11 @@ struct LoopStats {
   uint64_t consistent = 0;  // confirmed, but the map already agreed with them within their uncertainty
   uint64_t closures = 0;    // accepted: the map was corrected
   uint64_t merges = 0;      // closures that joined two segments
+  uint64_t skipped = 0;     // keyframes not queried: a correction was being solved
+  uint64_t restarted = 0;   // corrections solved again: a segment was moved or rescaled during the solve
   int64_t last_keyframe = -1, last_candidate = -1;  // place keyframe ids of the last closure
   double last_correction_m = 0, last_correction_deg = 0;
   double last_solve_ms = 0;
-};
-
-// A loop: keyframe b seen from keyframe a, with the uncertainty of the verification.
-struct LoopEdge {
-  int64_t a = -1, b = -1;  // place keyframe ids
-  SE3 T_a_b;
-  Vec6 sigma = Vec6::Ones();
 };
 
 // The map file's loops part: the loops, then each of the map's segments' root (which segment the loops joined it
@@ -47,10 +41,15 @@ class LoopCloser {
   LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera);
 
   void setRig(const Rig& rig) { verifier_.setRig(rig); }
-  // Keyframe `slot` (just added, with the frame it was made of and its words): true when a loop was closed and the
-  // map's poses and segments' frames moved.
+  // Keyframe `slot` (just added, with the frame it was made of and its words): true when it closed a loop, whose
+  // correction is then being solved; the map does not move until takeCorrection().
   bool onKeyframe(int slot, const FrameFeatures& features, const FrameWords& words, PlaceMap& map,
                   const PlaceDatabase& database);
+  // At a frame boundary: a correction solved since moves the map's keyframes and segments' frames (true). With
+  // `wait`, one in flight is waited for; without, it is taken at the first call that finds it ready.
+  bool takeCorrection(PlaceMap& map, bool wait);
+  bool correcting() const { return correction_.running() || correction_wanted_; }
+  uint64_t threadAllocations() const { return correction_.threadAllocations(); }
   const LoopStats& stats() const { return stats_; }
   int loops() const { return loop_count_; }
   std::span<const LoopEdge> loopEdges() const { return {loops_.data(), static_cast<std::size_t>(loop_count_)}; }
@@ -67,20 +66,25 @@ class LoopCloser {
  private:
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
   bool closesALoop(const PlaceMap& map, int candidate, int slot) const;
-  // Solves the pose graph of the whole map with the loops so far; keyframes and segments' frames take the solution.
-  void correct(PlaceMap& map);
-  void buildGraph(const PlaceMap& map);
-  int segmentEnd(const PlaceMap& map, int32_t segment, bool oldest) const;  // slot, -1 when the segment is empty
-  int slotOfId(const PlaceMap& map, int64_t id) const;
+  // Starts solving the pose graph of the whole map with the loops so far (LoopCorrection).
+  void startCorrection(const PlaceMap& map);
   int32_t findRoot(int32_t segment);
 
   PlacesOptions options_;
   Relocalizer verifier_;
-  backend::PoseGraph graph_;
   std::vector<LoopEdge> loops_;
   int loop_count_ = 0;
-  std::vector<int32_t> node_of_slot_, slot_of_node_;
   std::vector<int32_t> segment_root_;  // union-find over segments joined by loops
+  std::vector<int32_t> roots_;         // scratch of startCorrection(): each segment's root
+  LoopCorrection correction_;
+  bool correction_wanted_ = false;  // a loop was accepted (or a solve went stale): solve (again)
+  // The last accepted loop, for the log when its correction lands.
+  struct Accepted {
+    int64_t keyframe = -1, candidate = -1;
+    Timestamp t_keyframe = 0, t_candidate = 0;
+    int inliers = 0;
+    SE3 correction;
+  } accepted_;
   // The last verified detection, waiting for the next keyframe to confirm it.
   int64_t pending_keyframe_ = -1;
   int32_t pending_segment_ = -1;

@@ -81,7 +81,10 @@ class PlaceMap {
   // Segments: T_w_o of each, and whether it is placed in the world. A run's first map defines the world and one
   // started after a loss continues the frame the odometry coasted in: both are placed. The first map of a run
   // that reuses a saved map is not, until the rig is recognized in the saved map (moveSegment) or a loop joins it.
-  int32_t createSegment(const SE3& T_w_o, bool placed = true);  // -1 when there are kMaxSegments
+  // `continues`: the segment whose frame this one's continues (the odometry coasted from it), -1 for none; kept in
+  // memory only, for a loop correction that lands after the new segment began (LoopCloser).
+  int32_t createSegment(const SE3& T_w_o, bool placed = true, int32_t continues = -1);  // -1 when kMaxSegments
+  int32_t continuesFrom(int32_t segment) const { return segment_continues_[static_cast<std::size_t>(segment)]; }
   int segments() const { return segment_count_; }
   const SE3& segmentPose(int32_t segment) const { return segment_T_w_o_[static_cast<std::size_t>(segment)]; }
   void setSegmentPose(int32_t segment, const SE3& T_w_o) { segment_T_w_o_[static_cast<std::size_t>(segment)] = T_w_o; }
@@ -89,6 +92,9 @@ class PlaceMap {
   void setPlaced(int32_t segment) { segment_placed_[static_cast<std::size_t>(segment)] = 1; }
   // The segment, as one rigid piece, now has T_w_o: its keyframes follow (a segment no loop has bent yet).
   void moveSegment(int32_t segment, const SE3& T_w_o);
+  // Times a segment was moved or rescaled as a whole (moveSegment, rescaleSegment, read, clear): a pose-graph
+  // solution computed from the poses before is stale.
+  uint64_t reshapes() const { return reshapes_; }
 
   // The map file's part of the place map: segments and live keyframes with their points, in slot order. read()
   // replaces the map by the file's, its keyframes in slots 0.. in that order; a file that does not fit the capacities,
@@ -114,6 +120,8 @@ class PlaceMap {
   std::vector<int32_t> newest_of_segment_;
   std::vector<SE3> segment_T_w_o_;
   std::vector<uint8_t> segment_placed_;
+  std::vector<int32_t> segment_continues_;
+  uint64_t reshapes_ = 0;
   mutable std::vector<int32_t> file_position_;  // scratch of write() and read(), one per slot
 
   void checkChains(const ByteReader& in);

@@ -44,6 +44,9 @@ class PlaceMemory {
 
   // After odometry.process(frame, frame_index, out): see above. `out` ends in the world frame.
   void afterOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);
+  // Takes a loop correction still being solved into the map (after the last frame, before reading the map).
+  void flush() { takeCorrection(/*wait=*/true); }
+  uint64_t threadAllocations() const { return loop_closer_.threadAllocations(); }  // by the loop closer's thread
 
   const PlaceMap& map() const { return map_; }
   const PlaceStats& stats() const { return stats_; }
@@ -64,6 +67,8 @@ class PlaceMemory {
   bool mapLoaded() const { return loaded_; }
 
  private:
+  // A loop correction solved since the last frame moves the map (PlacesOptions::wait_for_correction: waiting for it).
+  void takeCorrection(bool wait);
   void followSegment(const Odometry& odometry);
   void addKeyframe(const Odometry& odometry, int odometry_slot);
   void makeRoom();  // a full map lets its least needed keyframe go, keeping those loops join

@@ -40,6 +40,10 @@ struct PlacesOptions {
   // its uncertainty changes nothing.
   double loop_sigma_translation = 0.02;
   double loop_sigma_rotation_deg = 0.5;
+  // A loop's correction is solved on its own thread while the next frame is processed. true: the next frame waits
+  // for it, so that runs repeat exactly (mcslam-run); false: the first frame that finds it ready takes it, and no
+  // frame ever waits (mcslamd, a live rig). Set by the program, not by the configuration file.
+  bool wait_for_correction = true;
 
   // Localizing in a saved map (PlaceMemory::readMap), a recognition corrects the odometry only by what it can have
   // drifted since the last correction: this floor plus this share of the path (and likewise in angle). Visual odometry

@@ -1,0 +1,69 @@
+#pragma once
+// The place map's correction after a loop closure: a pose graph over every place keyframe (consecutive keyframes
+// of a segment joined by the odometry's relative poses, and the loops), solved on a thread of its own so that no
+// frame waits for it, and taken into the map at a frame boundary. The keyframes in the graph take its solution;
+// each segment's frame follows its newest keyframe in the graph (the odometry goes on from where the map now puts
+// it), and so do the keyframes made during the solve, which were placed through that frame; a segment begun during
+// the solve (or empty when it began) moves with the one it continues. Fixed memory: the graph and every buffer are
+// sized at construction.
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "mcslam/backend/pose_graph.hpp"
+#include "mcslam/places/place_map.hpp"
+
+namespace mcslam {
+
+// A loop: keyframe b seen from keyframe a, with the uncertainty of the verification.
+struct LoopEdge {
+  int64_t a = -1, b = -1;  // place keyframe ids
+  SE3 T_a_b;
+  Vec6 sigma = Vec6::Ones();
+};
+
+class PoseGraphWorker;
+
+class LoopCorrection {
+ public:
+  LoopCorrection(int max_keyframes, int max_loops);
+  ~LoopCorrection();  // lets a solve in flight finish
+  LoopCorrection(const LoopCorrection&) = delete;
+  LoopCorrection& operator=(const LoopCorrection&) = delete;
+
+  // Builds the graph of `map` with `loops` and starts solving it. Each set of segments that loops joined is held
+  // at the oldest keyframe of its root segment (`root_of_segment`, one per segment of the map). Only when
+  // running() is false.
+  void start(const PlaceMap& map, std::span<const LoopEdge> loops, std::span<const int32_t> root_of_segment);
+  bool running() const;
+
+  enum class Outcome {
+    None,     // nothing solved to take (none started, or, without `wait`, not finished)
+    Applied,  // the map took the solution
+    Stale,    // a segment was moved or rescaled during the solve (PlaceMap::reshapes): start again
+  };
+  // At a frame boundary. With `wait`, waits for a solve in flight.
+  Outcome take(PlaceMap& map, bool wait);
+  double lastSolveMs() const;
+  uint64_t threadAllocations() const;  // by the solving thread since it started
+
+ private:
+  void apply(PlaceMap& map);
+  int slotOfId(const PlaceMap& map, int64_t id) const;
+
+  backend::PoseGraph graph_;
+  std::vector<int32_t> node_of_slot_;
+  // What the graph being solved was built from: each node's keyframe id, each segment's newest node and its pose
+  // then, the map's reshape count, segment count and next keyframe id.
+  std::vector<int64_t> id_of_node_;
+  std::vector<int32_t> newest_node_;
+  std::vector<SE3> newest_pose_before_;
+  std::vector<SE3> segment_delta_;  // scratch of apply(): how each segment's frame moved
+  uint64_t graph_reshapes_ = 0;
+  int graph_segments_ = 0;
+  int64_t graph_next_id_ = 0;
+  std::unique_ptr<PoseGraphWorker> worker_;  // last: stops before the graph goes
+};
+
+}  // namespace mcslam

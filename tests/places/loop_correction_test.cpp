@@ -1,0 +1,129 @@
+// The loop correction on its own thread: the map takes the pose graph's solution at a frame boundary; keyframes
+// made during the solve move with their segment, a segment begun during it moves with the one it continues; a
+// segment moved during the solve makes the solution stale; without waiting, the solution is taken once ready; a
+// correction allocates nothing after the first, on either thread.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <thread>
+#include <vector>
+
+#include "alloc_testing.hpp"
+#include "mcslam/places/loop_correction.hpp"
+
+namespace mcslam {
+namespace {
+
+SE3 poseAt(double angle_rad, double radius) {
+  return {so3Exp(Vec3(0, 0, angle_rad + M_PI / 2)),
+          Vec3(radius * std::cos(angle_rad), radius * std::sin(angle_rad), 0)};
+}
+
+// A circle of `n` keyframes, as a drifting odometry chains them (a yaw error per step), in one segment whose
+// odometry frame is the world's; and the loop the last keyframe closes onto the first.
+struct DriftedLoop {
+  PlaceMap map{64, 1};
+  int32_t segment = -1;
+  std::vector<SE3> truth;
+  LoopEdge loop;
+};
+
+DriftedLoop driftedLoop(int n) {
+  DriftedLoop d;
+  d.segment = d.map.createSegment(SE3());
+  const SE3 drift(so3Exp(Vec3(0, 0, 0.01)), Vec3::Zero());
+  SE3 chained = poseAt(0, 10);
+  for (int i = 0; i < n; ++i) {
+    d.truth.push_back(poseAt(2 * M_PI * i / n, 10));
+    if (i > 0) chained = chained * drift * (d.truth[i - 1].inverse() * d.truth[i]);
+    d.map.createKeyframe(d.segment, i, static_cast<uint64_t>(i), chained, chained);
+  }
+  d.loop = {d.map.keyframe(0).id, d.map.keyframe(n - 1).id, d.truth[0].inverse() * d.truth[n - 1],
+            Vec6::Constant(0.01)};
+  return d;
+}
+
+const std::vector<int32_t> kOwnRoots = {0, 1, 2, 3};
+
+TEST(LoopCorrection, TheMapTakesTheSolutionAndItsFrameFollowsTheNewestKeyframe) {
+  DriftedLoop d = driftedLoop(40);
+  const double error_before = (d.map.keyframe(39).T_w_k.t - d.truth[39].t).norm();
+  LoopCorrection correction(64, 4);
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  EXPECT_EQ(correction.take(d.map, /*wait=*/true), LoopCorrection::Outcome::Applied);
+  EXPECT_FALSE(correction.running());
+  EXPECT_LT((d.map.keyframe(39).T_w_k.t - d.truth[39].t).norm(), 0.1 * error_before);
+  EXPECT_EQ(d.map.keyframe(0).T_w_k.t, d.truth[0].t);  // the oldest keyframe holds the gauge
+  const SE3 T_w_o = d.map.keyframe(39).T_w_k * d.map.keyframe(39).T_o_k.inverse();
+  EXPECT_LT((d.map.segmentPose(d.segment).t - T_w_o.t).norm(), 1e-9);
+  EXPECT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::None);  // taken once
+}
+
+TEST(LoopCorrection, WhatWasMadeDuringTheSolveMovesWithItsSegment) {
+  DriftedLoop d = driftedLoop(40);
+  LoopCorrection correction(64, 4);
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  // During the solve the odometry goes on: two keyframes through the segment's (old) frame, then a loss and a new
+  // segment continuing it, with a keyframe of its own.
+  const SE3 step(Mat3::Identity(), Vec3(0.5, 0, 0));
+  const SE3 T_o_a = d.map.keyframe(39).T_o_k * step, T_o_b = T_o_a * step;
+  const int a = d.map.createKeyframe(d.segment, 40, 40, d.map.segmentPose(d.segment) * T_o_a, T_o_a);
+  const int b = d.map.createKeyframe(d.segment, 41, 41, d.map.segmentPose(d.segment) * T_o_b, T_o_b);
+  const int32_t next = d.map.createSegment(d.map.segmentPose(d.segment), true, d.segment);
+  const int c = d.map.createKeyframe(next, 42, 42, d.map.segmentPose(next) * T_o_b, T_o_b);
+  ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
+  const SE3& T_w_o = d.map.segmentPose(d.segment);
+  EXPECT_LT((d.map.keyframe(a).T_w_k.t - (T_w_o * T_o_a).t).norm(), 1e-9);
+  EXPECT_LT((d.map.keyframe(b).T_w_k.t - (T_w_o * T_o_b).t).norm(), 1e-9);
+  EXPECT_LT((d.map.segmentPose(next).t - T_w_o.t).norm(), 1e-9);
+  EXPECT_LT((d.map.keyframe(c).T_w_k.t - d.map.keyframe(b).T_w_k.t).norm(), 1e-9);
+  // ... which is where the keyframe newest in the graph now is, as the odometry measured them from it.
+  EXPECT_LT((d.map.keyframe(b).T_w_k.t - (d.map.keyframe(39).T_w_k * step * step).t).norm(), 1e-9);
+}
+
+TEST(LoopCorrection, ASegmentMovedDuringTheSolveMakesItStale) {
+  DriftedLoop d = driftedLoop(40);
+  const SE3 before = d.map.keyframe(20).T_w_k;
+  LoopCorrection correction(64, 4);
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  d.map.moveSegment(d.segment, SE3(Mat3::Identity(), Vec3(0, 0, 1)));
+  EXPECT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Stale);
+  EXPECT_EQ(d.map.keyframe(20).T_w_k.t, before.t + Vec3(0, 0, 1));  // as moved, not as solved
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);                 // again, from the map as it is now
+  EXPECT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
+}
+
+TEST(LoopCorrection, WithoutWaitingTheSolutionIsTakenOnceReady) {
+  DriftedLoop d = driftedLoop(40);
+  LoopCorrection correction(64, 4);
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  LoopCorrection::Outcome outcome = LoopCorrection::Outcome::None;
+  int calls = 0;
+  while ((outcome = correction.take(d.map, /*wait=*/false)) == LoopCorrection::Outcome::None) {
+    ++calls;
+    std::this_thread::yield();
+  }
+  EXPECT_EQ(outcome, LoopCorrection::Outcome::Applied);
+  EXPECT_LT((d.map.keyframe(39).T_w_k.t - d.truth[39].t).norm(), 0.1);
+  EXPECT_FALSE(correction.running());
+  (void)calls;  // how many frames it took depends on the machine
+}
+
+TEST(LoopCorrection, AfterTheFirstACorrectionAllocatesNothingOnEitherThread) {
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
+  DriftedLoop d = driftedLoop(40);
+  LoopCorrection correction(64, 4);
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
+  const uint64_t solver_before = correction.threadAllocations();
+  alloc::ThreadScope scope;
+  const SE3 step(Mat3::Identity(), Vec3(0.5, 0, 0));
+  d.map.createKeyframe(d.segment, 40, 40, d.map.segmentPose(d.segment) * step, step);  // the graph grows
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
+  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_EQ(correction.threadAllocations() - solver_before, 0u);
+}
+
+}  // namespace
+}  // namespace mcslam
