@@ -52,6 +52,8 @@ if [ "$which" != thread ]; then
 fi
 if [ "$which" != address ]; then
   echo "run-sanitizers: ThreadSanitizer, $scope that run threads (build-tsan/)"
-  TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 run_job build-tsan thread sanitizer-ci-threads -L threads
+  # The suppressions cover uninstrumented libraries only (the file says which and why).
+  TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tools/sanitizers/tsan.supp" \
+    run_job build-tsan thread sanitizer-ci-threads -L threads
 fi
 echo "run-sanitizers: clean"

@@ -22,6 +22,10 @@ inline constexpr uint8_t kFlagKeyframe = 1u << 1;  // the pipeline made this fra
 // The position's unit is arbitrary, not metres: one camera, or a rig without overlapping cameras whose map has
 // not yet found its metric scale (it starts up to scale and finds it in turns). Orientation is unaffected.
 inline constexpr uint8_t kFlagUnscaled = 1u << 2;
+// Where the pose lies in the world is a guess: tracking was lost, relocalization did not bridge the loss, and the
+// new map is not yet joined to the old one. Poses are consistent among themselves; the flag clears, with
+// world_revision one higher, when a recognized place joins the maps (the pose then jumps by the correction).
+inline constexpr uint8_t kFlagUnanchored = 1u << 3;
 
 struct PoseRecord {
   uint64_t sequence = 0;                 // publish counter, 1 for the first pose of a daemon run, +1 per pose
@@ -41,6 +45,7 @@ struct PoseRecord {
   bool valid() const { return (flags & kFlagValid) != 0; }
   bool keyframe() const { return (flags & kFlagKeyframe) != 0; }
   bool unscaled() const { return (flags & kFlagUnscaled) != 0; }
+  bool unanchored() const { return (flags & kFlagUnanchored) != 0; }
 };
 
 enum class DecodeStatus { Ok, TooShort, BadMagic, BadVersion, BadSize };

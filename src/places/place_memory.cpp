@@ -20,7 +20,9 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1),
       file_words_(options.max_words_per_keyframe),
       kept_ids_(2 * static_cast<std::size_t>(options.max_loops)),
+      anchored_(PlaceMap::kMaxSegments, 0),
       root_placed_(PlaceMap::kMaxSegments),
+      root_anchored_(PlaceMap::kMaxSegments),
       vocabulary_fingerprint_(vocabularyFingerprint(vocabulary)) {
   for (int c = 0; c < rig.size(); ++c)
     cameras_.push_back({static_cast<uint32_t>(rig.model(c).width()), static_cast<uint32_t>(rig.model(c).height())});
@@ -57,6 +59,7 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
     }
   }
   out.world_revision = world_revision_;
+  out.unanchored = out.valid && segment_ >= 0 && !anchored_[static_cast<std::size_t>(segment_)];
 }
 
 // A new odometry map (after a loss nothing bridged, or the very first) is a new segment. Its frame continues the
@@ -74,6 +77,8 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
                  PlaceMap::kMaxSegments);
     return;
   }
+  // The run's first map defines the world; a later one is where the motion model left the rig.
+  anchored_[static_cast<std::size_t>(s)] = segment_ < 0 && !loaded_ ? 1 : 0;
   segment_ = s;
 }
 
@@ -163,6 +168,9 @@ void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, O
     if (!enterWorld(frame_index)) return;
   }
   if (!resumeOdometry(frame, frame_index, odometry, r.T_w_b, out)) return;
+  // The odometry goes on from a pose measured on that keyframe's points: in the world, if they are.
+  if (anchored_[static_cast<std::size_t>(map_.keyframe(r.keyframe).segment)])
+    anchored_[static_cast<std::size_t>(segment_)] = 1;
   ++stats_.relocalizations;
   stats_.last_relocalized_keyframe = map_.keyframe(r.keyframe).id;
   stats_.last_relocalized_frame = static_cast<int64_t>(frame_index);
@@ -206,6 +214,7 @@ bool PlaceMemory::enterWorld(uint64_t frame_index) {
     map_.eraseKeyframe(slot);
   }
   segment_ = s;
+  anchored_[static_cast<std::size_t>(s)] = 1;
   stats_.placed_frame = static_cast<int64_t>(frame_index);
   return true;
 }
@@ -231,6 +240,7 @@ void PlaceMemory::place(const FrameFeatures& frame, uint64_t frame_index, const 
   if (!map_.placed(segment_)) {
     map_.moveSegment(segment_, T_w_o);
     map_.setPlaced(segment_);
+    anchored_[static_cast<std::size_t>(segment_)] = 1;
     stats_.placed_frame = static_cast<int64_t>(frame_index);
     path_at_fix_ = path_;
     spdlog::info("place memory: frame {} recognized in the map on keyframe {} ({} inliers): poses are in its frame",
@@ -259,8 +269,19 @@ void PlaceMemory::place(const FrameFeatures& frame, uint64_t frame_index, const 
 
 void PlaceMemory::propagatePlacement() {
   std::fill(root_placed_.begin(), root_placed_.end(), 0);
-  for (int32_t s = 0; s < map_.segments(); ++s)
+  std::fill(root_anchored_.begin(), root_anchored_.end(), 0);
+  for (int32_t s = 0; s < map_.segments(); ++s) {
     if (map_.placed(s)) root_placed_[static_cast<std::size_t>(loop_closer_.root(s))] = 1;
+    if (anchored_[static_cast<std::size_t>(s)]) root_anchored_[static_cast<std::size_t>(loop_closer_.root(s))] = 1;
+  }
+  for (int32_t s = 0; s < map_.segments(); ++s) {
+    const auto root = static_cast<std::size_t>(loop_closer_.root(s));
+    if (root_anchored_[root] && !anchored_[static_cast<std::size_t>(s)]) {
+      anchored_[static_cast<std::size_t>(s)] = 1;
+      if (s == segment_)
+        spdlog::info("place memory: a loop joined this map to the one before the loss: poses are anchored");
+    }
+  }
   for (int32_t s = 0; s < map_.segments(); ++s) {
     if (map_.placed(s) || !root_placed_[static_cast<std::size_t>(loop_closer_.root(s))]) continue;
     map_.setPlaced(s);
@@ -333,6 +354,8 @@ void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool 
   loop_closer_.read(in, map_.segments());
   if (in.remaining() != 0) in.fail(std::to_string(in.remaining()) + " bytes of trailing data");
   loaded_ = true;
+  std::fill(anchored_.begin(), anchored_.end(), 0);
+  for (int32_t s = 0; s < map_.segments(); ++s) anchored_[static_cast<std::size_t>(s)] = map_.placed(s) ? 1 : 0;
   localize_only_ = localize_only;
   landmark_id_offset_ = last_landmark + 1;
   segment_ = -1;

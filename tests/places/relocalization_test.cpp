@@ -75,6 +75,7 @@ TEST_F(Relocalization, AfterABlackoutOnAStraightTheRigIsFoundInTheSameFrame) {
   EXPECT_GE(frame, 80);
   EXPECT_LT(frame, 85);  // within 5 frames of the images' return
   EXPECT_EQ(jsonInt(black.stats, "segments"), 1);
+  EXPECT_EQ(jsonInt(black.stats, "unanchored"), 0);  // the loss was bridged: every pose is measured in the world
   EXPECT_LT(black.ate, 1.5 * plain.ate) << "plain " << plain.ate;
 }
 
@@ -93,10 +94,14 @@ TEST_F(Relocalization, AFullPlaceMapCullsAndStillRelocalizes) {
   EXPECT_LT(black.ate, 1.5 * plain.ate) << "plain " << plain.ate;
 }
 
+// The new map's poses are flagged: their place in the world is where the motion model left the rig.
 TEST_F(Relocalization, ABlackoutIntoAnUnseenRoomFindsNothingAndStartsANewMap) {
   const Run black = run("turn", "--black 150-169");
   EXPECT_EQ(jsonInt(black.stats, "relocalizations"), 0) << black.stats;
   EXPECT_EQ(jsonInt(black.stats, "segments"), 2);
+  const long unanchored = jsonInt(black.stats, "unanchored");
+  EXPECT_GT(unanchored, 0) << black.stats;
+  EXPECT_LE(unanchored, jsonInt(black.stats, "frames") - 170) << black.stats;  // none before the blackout
 }
 
 // Map reuse: the first 100 frames save their map; the rest, run by a new process, localize in it. From its first

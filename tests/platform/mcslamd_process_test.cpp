@@ -102,6 +102,25 @@ pid_t spawnDaemon(const std::string& config, const std::string& notify, const st
   return pid;
 }
 
+// A daemon the test started does not outlive it: a failed assertion returns early, and the daemon would go on
+// (replaying, holding its shared memory) after the test process is gone.
+class ReapOnExit {
+ public:
+  explicit ReapOnExit(pid_t pid) : pid_(pid) {}
+  ~ReapOnExit() {
+    int status = 0;
+    if (pid_ > 0 && ::waitpid(pid_, &status, WNOHANG) == 0) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, &status, 0);
+    }
+  }
+  ReapOnExit(const ReapOnExit&) = delete;
+  ReapOnExit& operator=(const ReapOnExit&) = delete;
+
+ private:
+  pid_t pid_;
+};
+
 // Waits (liveness bound only) for the child; returns its exit status, or -1.
 int waitExit(pid_t pid, int seconds) {
   const auto deadline = Clock::now() + std::chrono::seconds(seconds);
@@ -196,6 +215,7 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
                                                  "output:\n  directory: out\n  extrinsics: refined/extrinsics.yaml\n");
   std::filesystem::create_directories(dir.file("out/refined"));
   const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "400000", dir.file("log.txt"));
+  const ReapOnExit reap_pid(pid);
   ASSERT_GT(pid, 0);
 
   ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));
@@ -307,6 +327,7 @@ TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
                       "trigger:\n  mode: software\n  rate_hz: 0.1\n"
                       "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
   const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "100000", dir.file("log.txt"));
+  const ReapOnExit reap_pid(pid);
   ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));
   ASSERT_TRUE(waitFor([&] { return notify.count("STATUS=") >= 5; }));  // ticks happened (every 50 ms)
   EXPECT_EQ(notify.count("WATCHDOG=1"), 0) << "watchdog kept alive without progress";
@@ -326,6 +347,7 @@ TEST(McslamdProcess, ImageCodecIsMappedOnlyWhenTheReplayMeetsAPng) {
             "\n    rate: fastest\n    at_end: loop\npublish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
     const std::string log = dir.file(data + ".log");
     const pid_t pid = spawnDaemon(config, dir.file(data + ".sock"), "400000", log);
+    const ReapOnExit reap_pid(pid);
     // WATCHDOG=1 is sent only once frames are processed: their images were read by then.
     ASSERT_TRUE(waitFor([&] { return notify.count("WATCHDOG=1") >= 1; })) << readAll(log);
     const std::string maps = readAll("/proc/" + std::to_string(pid) + "/maps");
@@ -423,6 +445,7 @@ TEST(McslamdProcess, AfterACrashTheRestartedDaemonKeepsTheWorldFrame) {
   std::filesystem::create_directories(dir.file("out2"));
   const std::string first = test::writeFile(dir.file("first.yaml"), mapConfig(data, dir.file("out1"), map, "loop"));
   const pid_t pid = spawnDaemon(first, dir.file("none.sock"), "0", dir.file("log1.txt"));
+  const ReapOnExit reap_pid(pid);
   ASSERT_GT(pid, 0);
   // A save made after the whole route was mapped once (the map file is replaced whole, never partly written).
   ASSERT_TRUE(waitFor([&] { return readTumRows(dir.file("out1/trajectory.tum")).size() >= 60; }, 120))
@@ -439,6 +462,7 @@ TEST(McslamdProcess, AfterACrashTheRestartedDaemonKeepsTheWorldFrame) {
   const std::string tail = datasetTail(data, dir.file("tail"), 25);
   const std::string second = test::writeFile(dir.file("second.yaml"), mapConfig(tail, dir.file("out2"), map, "exit"));
   const pid_t again = spawnDaemon(second, dir.file("none.sock"), "0", dir.file("log2.txt"));
+  const ReapOnExit reap_again(again);
   ASSERT_EQ(waitExit(again, 120), 0) << readAll(dir.file("log2.txt"));
   const std::string log2 = readAll(dir.file("log2.txt"));
   EXPECT_NE(log2.find("recognized in the map"), std::string::npos) << log2;

@@ -83,7 +83,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   if (!out) throw InputError(path + ": cannot write stats file");
   std::vector<double> features, tracking, optimization, total;
   uint64_t state_count[4] = {0, 0, 0, 0};
-  int interpolated = 0, unknown_scale = 0;
+  int interpolated = 0, unknown_scale = 0, unanchored = 0;
   for (const FrameRecord& r : frames_) {
     features.push_back(r.timing.features_ms);
     tracking.push_back(r.timing.tracking_ms);
@@ -92,6 +92,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     ++state_count[static_cast<int>(r.pose.state)];
     interpolated += r.interpolated ? 1 : 0;
     unknown_scale += r.unknown_scale ? 1 : 0;
+    unanchored += r.pose.unanchored ? 1 : 0;
   }
   const OdometryStats& s = pipeline.stats();
   JsonWriter j(out);
@@ -107,6 +108,9 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("not_initialized").value(state_count[static_cast<int>(TrackingState::NotInitialized)]);
   j.key("lost").value(state_count[static_cast<int>(TrackingState::Lost)]);
   j.key("localizing").value(state_count[static_cast<int>(TrackingState::Localizing)]);
+  // Valid poses whose place in the world was the motion model's guess (a new map after an unbridged loss, not
+  // yet joined to the old one: PoseEstimate::unanchored).
+  j.key("unanchored").value(unanchored);
   j.endObject();
   // Where tracking was lost and regained: every change of state, with its frame index and time.
   j.key("state_changes").beginArray();

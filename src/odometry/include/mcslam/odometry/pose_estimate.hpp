@@ -39,6 +39,10 @@ struct PoseEstimate {
   // Times the world estimate has moved so far (loop closures, map merges): a consumer that sees it change knows
   // that the jump between this pose and the one before is a correction of the world, not motion.
   uint16_t world_revision = 0;
+  // Where T_w_b lies in the world is the motion model's guess: tracking was lost, relocalization did not bridge
+  // the loss, and the new map is not yet joined to the old one (a recognized place clears it, with a new
+  // world_revision). Poses are consistent among themselves meanwhile.
+  bool unanchored = false;
 };
 
 }  // namespace mcslam

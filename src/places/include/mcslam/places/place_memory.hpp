@@ -81,7 +81,8 @@ class PlaceMemory {
   // `out` lost) when it could not.
   bool resumeOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, const SE3& T_w_b,
                       PoseEstimate& out);
-  void propagatePlacement();  // after a loop: segments joined to a placed one are placed
+  // After a loop: segments joined to a placed one are placed, and those joined to an anchored one anchored.
+  void propagatePlacement();
 
   const Vocabulary& vocabulary_;
   PlacesOptions options_;
@@ -106,9 +107,12 @@ class PlaceMemory {
   double path_ = 0, path_at_fix_ = 0;
   Vec3 last_position_ = Vec3::Zero();
   bool have_last_position_ = false;
-  BowVector file_words_;              // scratch of readMap()
-  std::vector<int64_t> kept_ids_;     // scratch of makeRoom(): the loops' keyframes, sorted
-  std::vector<uint8_t> root_placed_;  // scratch of propagatePlacement(), per segment
+  BowVector file_words_;           // scratch of readMap()
+  std::vector<int64_t> kept_ids_;  // scratch of makeRoom(): the loops' keyframes, sorted
+  // Per segment: its place in the world was measured (the run's first map, a map file's, one recognized in the
+  // map or joined to an anchored one by a loop), not guessed by the motion model across a loss.
+  std::vector<uint8_t> anchored_;
+  std::vector<uint8_t> root_placed_, root_anchored_;  // scratch of propagatePlacement(), per segment
   std::vector<MapFileHeader::Camera> cameras_;
   mutable MapFileHeader file_header_;  // scratch of writeMap(), its cameras sized at construction
   uint32_t vocabulary_fingerprint_ = 0;
