@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 
+#include "mcslam/core/error.hpp"
 #include "mcslam/geometry/ransac.hpp"
 #include "mcslam/geometry/relative_pose_refinement.hpp"
 #include "mcslam/geometry/relative_pose_solvers.hpp"
@@ -321,6 +322,10 @@ const RelativePoseResult& RelativePoseEstimator::generalized(const Rig& rig,
                                                              std::span<const RelativeCorrespondence> matches,
                                                              const RelativePoseOptions& o) {
   Workspace& ws = *ws_;
+  // The per-camera buffers were sized at construction: a larger rig would lose its other cameras' matches.
+  if (rig.size() > static_cast<int>(ws.per_camera.size()))
+    throw InputError("RelativePoseEstimator: a rig of " + std::to_string(rig.size()) + " cameras, built for at most " +
+                     std::to_string(ws.per_camera.size()));
   RelativePoseResult& result = ws.result;
   clearResult(result, matches.size(), ws.capacity);
   if (rig.size() < 2) {  // one camera: no metric scale

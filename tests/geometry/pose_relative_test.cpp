@@ -5,6 +5,7 @@
 
 #include "alloc_testing.hpp"
 #include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/core/error.hpp"
 #include "mcslam/geometry/relative_pose.hpp"
 #include "mcslam/geometry/relative_pose_refinement.hpp"
 #include "mcslam/geometry/relative_pose_solvers.hpp"
@@ -254,6 +255,14 @@ TEST(RelativePoseSolvers, LinearGeneralizedRecoversMetricPose) {
 
 // A rig that loses tracking after the warm-up starts a new map through the relative pose: once constructed, the
 // estimator allocates nothing, in the generalized and the central case.
+TEST(RelativePoseSolvers, AnEstimatorRefusesARigLargerThanItWasBuiltFor) {
+  const Rig rig = trinocularRig();
+  SceneRandom r(31);
+  const TwoFrames f = makeTwoFrames(rig, motion(10, Vec3(0.3, 0, 0.5)), 100, 0.0, 0.3, r);
+  RelativePoseEstimator estimator(200, 2);
+  EXPECT_THROW(estimator.generalized(rig, f.matches, optionsForNoise(0.3)), InputError);
+}
+
 TEST(RelativePoseSolvers, EstimatorAllocatesNothingAfterConstruction) {
   SKIP_UNLESS_COUNTING_ALLOCATIONS();
   const Rig rig = wideNonOverlappingRig();
