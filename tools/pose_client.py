@@ -22,6 +22,7 @@ TRACKING = {0: "not_initialized", 1: "tracking", 2: "lost", 3: "localizing"}
 FLAG_VALID = 1
 FLAG_KEYFRAME = 2
 FLAG_UNSCALED = 4  # position in an arbitrary unit, not metres
+FLAG_UNANCHORED = 8  # the pose's place in the world is a guess since an unbridged loss (docs/pose-protocol.md)
 
 
 def decode(data):
@@ -42,7 +43,7 @@ def decode(data):
         "position": (px, py, pz), "orientation": (qx, qy, qz, qw),
         "tracking": TRACKING.get(state, "unknown"),
         "valid": bool(flags & FLAG_VALID), "keyframe": bool(flags & FLAG_KEYFRAME),
-        "unscaled": bool(flags & FLAG_UNSCALED),
+        "unscaled": bool(flags & FLAG_UNSCALED), "unanchored": bool(flags & FLAG_UNANCHORED),
         "quality": quality, "world_revision": world_revision,
     }
 
