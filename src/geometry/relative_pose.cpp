@@ -278,7 +278,7 @@ bool rotationFirstHypothesis(const Rig& rig, std::span<const RelativeCorresponde
   return true;
 }
 
-// The linear solver on all the inliers of the RANSAC pose: far less noisy than on 17 points.
+// The linear solver on all the inliers of the RANSAC pose: least squares over every inlier, not a minimal sample.
 bool allInlierHypothesis(const SE3& ransac_pose, const RelativePoseOptions& o, Workspace& ws, SE3& T) {
   ws.sample_mask.resize(ws.rays.size());
   selectInliers(ws.rays, ransac_pose, inlierAngle(o), ws.sample_mask);
