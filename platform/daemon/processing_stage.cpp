@@ -107,6 +107,7 @@ void ProcessingStage::handOver(PoseSlot& out, const FrameTag& tag) {
   pressure_.done();
   if (!warm_up_.warm() && done >= warmup_frames_) warm_up_.end(done);
   processing_meter_.note(warm_up_.warm());
+  background_meter_.note(warm_up_.warm(), processor_.backgroundThreadAllocations());
 }
 
 void ProcessingStage::afterFrame() {

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "backend_worker.hpp"
-
 namespace mcslam {
 
 namespace {
@@ -45,16 +43,18 @@ WindowBridge::WindowBridge(const Rig& calibration, const OdometryOptions& option
   if (options.backend) {
     solver_ = std::make_unique<backend::SlidingWindowSolver>(
         calibration, windowCapacity(options, cams, max_features_per_camera), solverOptions(options, monocular_));
-    if (options.backend_thread) worker_ = std::make_unique<BackendWorker>();
+    solve_.solver = solver_.get();
+    solve_.iterations = options.backend_iterations;
+    if (options.backend_thread) task_ = std::make_unique<BackgroundTask>();
   }
 }
 
 WindowBridge::~WindowBridge() {
-  if (worker_) worker_->wait();  // the solver must outlive a solve in flight
+  if (task_) task_->wait();  // the solver must outlive a solve in flight
 }
 
 void WindowBridge::reset() {
-  if (worker_) worker_->wait();
+  if (task_) task_->collect();
   solving_ = false;  // the window is dropped with the map: its last result does not matter
   if (!solver_) return;
   // An empty window (the old one's keyframes and landmarks are gone with the map), on the same prior, starting from
@@ -103,14 +103,8 @@ void WindowBridge::holdScale(bool hold) {
 }
 
 Rig WindowBridge::refinedRig() const {
-  if (worker_) worker_->wait();
+  if (task_) task_->wait();
   return solver_ ? solver_->refinedRig() : rig_state_.rig();
-}
-
-uint64_t WindowBridge::backendThreadAllocations() const {
-  if (!worker_) return 0;
-  worker_->wait();
-  return worker_->allocations();
 }
 
 int WindowBridge::keyframeSlotOfId(const Map& map, int64_t id) const {
@@ -136,10 +130,10 @@ bool WindowBridge::beginSolve(Map& map, int slot) {
   finishSolve(map);  // one window at a time
   if (!feed(map, slot)) return false;
   solving_ = true;
-  if (worker_) {
-    worker_->start(*solver_, options_.backend_iterations);
+  if (task_) {
+    task_->start(solve_);
   } else {
-    inline_summary_ = solver_->solve(options_.backend_iterations);
+    solve_.run();
   }
   return true;
 }
@@ -197,7 +191,8 @@ void WindowBridge::addLandmarkObservations(Map& map, const Keyframe& kf) {
 bool WindowBridge::finishSolve(Map& map) {
   if (!solving_) return false;
   solving_ = false;
-  const backend::SolveSummary summary = worker_ ? worker_->wait() : inline_summary_;
+  if (task_) task_->collect();
+  const backend::SolveSummary& summary = solve_.summary;
   ++solves_;
   removeOutliers(map);
   if (!summary.failed) writeBack(map);

@@ -1,8 +1,7 @@
 #include "mcslam/places/loop_correction.hpp"
 
 #include <algorithm>
-
-#include "pose_graph_worker.hpp"
+#include <numeric>
 
 namespace mcslam {
 
@@ -25,23 +24,31 @@ LoopCorrection::LoopCorrection(int max_keyframes, int max_loops)
     : graph_(max_keyframes, 2 * max_keyframes + max_loops),
       node_of_slot_(static_cast<std::size_t>(max_keyframes), -1),
       id_of_node_(static_cast<std::size_t>(max_keyframes), -1),
+      nodes_by_id_(static_cast<std::size_t>(max_keyframes), -1),
       newest_node_(PlaceMap::kMaxSegments, -1),
       newest_pose_before_(PlaceMap::kMaxSegments),
-      segment_delta_(PlaceMap::kMaxSegments),
-      worker_(std::make_unique<PoseGraphWorker>()) {}
+      segment_delta_(PlaceMap::kMaxSegments) {
+  solve_.graph = &graph_;
+}
 
-LoopCorrection::~LoopCorrection() = default;
+int LoopCorrection::nodeOfId(int64_t id, int nodes) const {
+  const auto end = nodes_by_id_.begin() + nodes;
+  const auto it = std::lower_bound(nodes_by_id_.begin(), end, id, [this](int32_t node, int64_t value) {
+    return id_of_node_[static_cast<std::size_t>(node)] < value;
+  });
+  return it != end && id_of_node_[static_cast<std::size_t>(*it)] == id ? *it : -1;
+}
 
-bool LoopCorrection::running() const { return worker_->running(); }
-
-double LoopCorrection::lastSolveMs() const { return worker_->lastSolveMs(); }
-
-uint64_t LoopCorrection::threadAllocations() const { return worker_->allocations(); }
-
-int LoopCorrection::slotOfId(const PlaceMap& map, int64_t id) const {
-  for (int slot = 0; slot < map.capacity(); ++slot)
-    if (map.keyframe(slot).alive && map.keyframe(slot).id == id) return slot;
-  return -1;
+void LoopCorrection::addLoops(std::span<const LoopEdge> loops, int nodes) {
+  const auto end = nodes_by_id_.begin() + nodes;
+  std::iota(nodes_by_id_.begin(), end, 0);
+  std::sort(nodes_by_id_.begin(), end, [this](int32_t a, int32_t b) {
+    return id_of_node_[static_cast<std::size_t>(a)] < id_of_node_[static_cast<std::size_t>(b)];
+  });
+  for (const LoopEdge& e : loops) {
+    const int a = nodeOfId(e.a, nodes), b = nodeOfId(e.b, nodes);
+    if (a >= 0 && b >= 0) graph_.addEdge(a, b, e.T_a_b, e.sigma);
+  }
 }
 
 void LoopCorrection::start(const PlaceMap& map, std::span<const LoopEdge> loops,
@@ -69,21 +76,16 @@ void LoopCorrection::start(const PlaceMap& map, std::span<const LoopEdge> loops,
     graph_.addEdge(node_of_slot_[static_cast<std::size_t>(k.previous)], node_of_slot_[static_cast<std::size_t>(slot)],
                    T_a_b, odometrySigma(T_a_b));
   }
-  for (const LoopEdge& e : loops) {
-    const int a = slotOfId(map, e.a), b = slotOfId(map, e.b);
-    if (a >= 0 && b >= 0)
-      graph_.addEdge(node_of_slot_[static_cast<std::size_t>(a)], node_of_slot_[static_cast<std::size_t>(b)], e.T_a_b,
-                     e.sigma);
-  }
+  addLoops(loops, graph_.nodes());
   graph_reshapes_ = map.reshapes();
   graph_segments_ = map.segments();
   graph_next_id_ = map.nextId();
-  worker_->start(graph_);
+  task_.start(solve_);
 }
 
 LoopCorrection::Outcome LoopCorrection::take(PlaceMap& map, bool wait) {
-  if (!worker_->running() || (!wait && !worker_->ready())) return Outcome::None;
-  worker_->collect();
+  if (!task_.running() || (!wait && !task_.ready())) return Outcome::None;
+  task_.collect();
   if (map.reshapes() != graph_reshapes_) return Outcome::Stale;
   apply(map);
   return Outcome::Applied;

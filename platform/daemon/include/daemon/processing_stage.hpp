@@ -35,7 +35,10 @@ class ProcessingStage {
   uint64_t waiting() const { return runner_.waiting(); }  // prepared, not yet finished
   TrackingState tracking() const { return static_cast<TrackingState>(tracking_.load(std::memory_order_relaxed)); }
   bool unscaled() const { return unscaled_.load(std::memory_order_relaxed); }
-  uint64_t allocationsSinceWarmup() const { return features_meter_.since() + processing_meter_.since(); }
+  // By the features and processing threads and the processor's own (back-end, loop correction).
+  uint64_t allocationsSinceWarmup() const {
+    return features_meter_.since() + processing_meter_.since() + background_meter_.since();
+  }
   // As of the last frame processed (zeros for a processor without place memory).
   PlaceCounters placeCounters() const;
 
@@ -73,6 +76,7 @@ class ProcessingStage {
   std::atomic<int64_t> place_keyframes_{0};
   std::atomic<uint16_t> world_revision_{0};
   ThreadAllocMeter features_meter_, processing_meter_;
+  ThreadAllocMeter background_meter_;  // the processor's own threads, read after each frame
 };
 
 }  // namespace mcslam::platform

@@ -1,6 +1,7 @@
 #pragma once
 // Counts one thread's heap allocations after the warm-up: the thread calls note() after each item;
-// once `counting` turns true the current count becomes the baseline. Others read since().
+// once `counting` turns true the current count becomes the baseline. Others read since(). A count kept elsewhere
+// (threads the meter's thread does not run) is metered the same way by handing it to note().
 #include <atomic>
 #include <cstdint>
 
@@ -10,8 +11,8 @@ namespace mcslam::platform {
 
 class ThreadAllocMeter {
  public:
-  void note(bool counting) {
-    const uint64_t now = alloc::threadCount();
+  void note(bool counting) { note(counting, alloc::threadCount()); }
+  void note(bool counting, uint64_t now) {
     if (!based_.load(std::memory_order_relaxed)) {
       if (!counting) return;
       baseline_.store(now, std::memory_order_relaxed);

@@ -10,14 +10,13 @@
 #include <vector>
 
 #include "mcslam/backend/sliding_window_solver.hpp"
+#include "mcslam/core/background_task.hpp"
 #include "mcslam/features/octave_scales.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
 #include "mcslam/odometry/rig_state.hpp"
 
 namespace mcslam {
-
-class BackendWorker;
 
 class WindowBridge {
  public:
@@ -59,8 +58,8 @@ class WindowBridge {
 
   // The rig with the extrinsics the window refined (the rig state's when there is no back-end).
   Rig refinedRig() const;
-  // Heap allocations made by the back-end thread, all solves (0 without it): for the fixed-memory tests.
-  uint64_t backendThreadAllocations() const;
+  // Heap allocations made by the back-end thread, all solves (0 without it); any thread may ask.
+  uint64_t backendThreadAllocations() const { return task_ ? task_->allocations() : 0; }
   uint64_t solves() const { return solves_; }
 
  private:
@@ -71,6 +70,13 @@ class WindowBridge {
   void writeBack(Map& map);
   int keyframeSlotOfId(const Map& map, int64_t id) const;
 
+  struct WindowSolve final : BackgroundJob {
+    void run() override { summary = solver->solve(iterations); }
+    backend::SlidingWindowSolver* solver = nullptr;
+    int iterations = 0;
+    backend::SolveSummary summary;
+  };
+
   RigState rig_state_;                        // with refinement on, its extrinsics follow the estimates
   Rig calibration_;                           // the window's prior, also for a new window after a reset
   std::vector<uint8_t> calibration_dropped_;  // per camera: reestimateExtrinsic() showed its calibration wrong
@@ -78,9 +84,9 @@ class WindowBridge {
   int capacity_;
   bool monocular_;
   std::unique_ptr<backend::SlidingWindowSolver> solver_;
-  std::unique_ptr<BackendWorker> worker_;  // null: the solve runs inside beginSolve()
+  WindowSolve solve_;
+  std::unique_ptr<BackgroundTask> task_;  // the back-end thread; null: the solve runs inside beginSolve()
   bool solving_ = false;
-  backend::SolveSummary inline_summary_;
   std::vector<backend::ObservationKey> outliers_;
   OctaveScales octave_scale_{options_.scale_factor};
   uint64_t solves_ = 0;

@@ -76,6 +76,9 @@ class FrameProcessor {
     (void)out;
     return false;
   }
+  // Heap allocations made so far by the processor's own threads beyond prepare()'s and finish()'s (a back-end
+  // solver's, say); any thread may ask, at any time.
+  virtual uint64_t backgroundThreadAllocations() const { return 0; }
 };
 
 inline void FrameProcessor::loadMap(const std::string& path, bool localize_only) {

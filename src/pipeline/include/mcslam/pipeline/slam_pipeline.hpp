@@ -38,7 +38,7 @@ class SlamPipeline final : public FrameProcessor {
   void flush();
   // Heap allocations the back-end's and the loop closer's threads have made so far (zero without the counting
   // hooks).
-  uint64_t backgroundThreadAllocations() const;
+  uint64_t backgroundThreadAllocations() const override;
 
   // Read on the thread that finishes the frames, between frames.
   const PipelineTiming& timing() const { return timing_; }  // of the last finished frame

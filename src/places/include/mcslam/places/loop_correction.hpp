@@ -7,11 +7,11 @@
 // the solve (or empty when it began) moves with the one it continues. Fixed memory: the graph and every buffer are
 // sized at construction.
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <vector>
 
 #include "mcslam/backend/pose_graph.hpp"
+#include "mcslam/core/background_task.hpp"
 #include "mcslam/places/place_map.hpp"
 
 namespace mcslam {
@@ -23,12 +23,9 @@ struct LoopEdge {
   Vec6 sigma = Vec6::Ones();
 };
 
-class PoseGraphWorker;
-
 class LoopCorrection {
  public:
-  LoopCorrection(int max_keyframes, int max_loops);
-  ~LoopCorrection();  // lets a solve in flight finish
+  LoopCorrection(int max_keyframes, int max_loops);  // starts the solving thread; its destructor lets a solve finish
   LoopCorrection(const LoopCorrection&) = delete;
   LoopCorrection& operator=(const LoopCorrection&) = delete;
 
@@ -36,7 +33,7 @@ class LoopCorrection {
   // at the oldest keyframe of its root segment (`root_of_segment`, one per segment of the map). Only when
   // running() is false.
   void start(const PlaceMap& map, std::span<const LoopEdge> loops, std::span<const int32_t> root_of_segment);
-  bool running() const;
+  bool running() const { return task_.running(); }
 
   enum class Outcome {
     None,     // nothing solved to take (none started, or, without `wait`, not finished)
@@ -45,25 +42,33 @@ class LoopCorrection {
   };
   // At a frame boundary. With `wait`, waits for a solve in flight.
   Outcome take(PlaceMap& map, bool wait);
-  double lastSolveMs() const;
-  uint64_t threadAllocations() const;  // by the solving thread since it started
+  double lastSolveMs() const { return task_.lastMilliseconds(); }
+  uint64_t threadAllocations() const { return task_.allocations(); }  // by the solving thread; any thread may ask
 
  private:
+  struct GraphSolve final : BackgroundJob {
+    void run() override { graph->optimize(); }
+    backend::PoseGraph* graph = nullptr;
+  };
+
   void apply(PlaceMap& map);
-  int slotOfId(const PlaceMap& map, int64_t id) const;
+  void addLoops(std::span<const LoopEdge> loops, int nodes);
+  int nodeOfId(int64_t id, int nodes) const;  // -1 when no node has it (the keyframe was let go)
 
   backend::PoseGraph graph_;
+  GraphSolve solve_;
   std::vector<int32_t> node_of_slot_;
   // What the graph being solved was built from: each node's keyframe id, each segment's newest node and its pose
   // then, the map's reshape count, segment count and next keyframe id.
   std::vector<int64_t> id_of_node_;
+  std::vector<int32_t> nodes_by_id_;  // scratch of start(): the nodes in increasing keyframe id
   std::vector<int32_t> newest_node_;
   std::vector<SE3> newest_pose_before_;
   std::vector<SE3> segment_delta_;  // scratch of apply(): how each segment's frame moved
   uint64_t graph_reshapes_ = 0;
   int graph_segments_ = 0;
   int64_t graph_next_id_ = 0;
-  std::unique_ptr<PoseGraphWorker> worker_;  // last: stops before the graph goes
+  BackgroundTask task_;  // last: stops before the graph goes
 };
 
 }  // namespace mcslam
