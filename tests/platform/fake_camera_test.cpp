@@ -32,7 +32,7 @@ const char* kFakeCamera = "/usr/bin/arv-fake-gv-camera-0.8";
 class FakeCamera {
  public:
   FakeCamera() {
-    pid_ = ::fork();
+    pid_ = test::forkDyingWithParent();
     if (pid_ == 0) {
       const int null = ::open("/dev/null", O_WRONLY);
       ::dup2(null, 1);
@@ -97,7 +97,7 @@ TEST(FakeGigECamera, FramesFlowThroughTheWholeDaemonWithSoftwareTrigger) {
                                              "trigger:\n  mode: software\n  rate_hz: 20\nstatus_interval_s: 0.5\n"
                                              "publish:\n  shm:\n    name: " +
                                                  shm + "\noutput:\n  directory: " + dir.path().string() + "\n"));
-  const pid_t pid = ::fork();
+  const pid_t pid = test::forkDyingWithParent();
   if (pid == 0) {
     const int fd = ::open(dir.file("log.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     ::dup2(fd, 1);

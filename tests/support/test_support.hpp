@@ -1,5 +1,7 @@
 #pragma once
 // Helpers shared by the tests.
+#include <sys/types.h>
+
 #include <filesystem>
 #include <string>
 
@@ -31,5 +33,9 @@ std::string readFile(const std::string& path);
 
 // Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
 int runCommand(const std::string& command, std::string* output = nullptr);
+
+// Forks a child that receives SIGKILL when the test process ends, however it ends (a ctest timeout included), so
+// that no daemon or fake camera outlives its test. Returns fork()'s value.
+pid_t forkDyingWithParent();
 
 }  // namespace mcslam::test
