@@ -4,7 +4,8 @@
 Written from docs/pose-protocol.md alone, with the Python standard library only, to show that the
 document is enough. Output lines match mcslam-udp-echo / mcslam-shm-echo:
 
-  seq 12 frame 12 t 1403636579.763555584 state tracking valid 1 kf 0 unscaled 0 quality 0.830 p <x y z> q <x y z w>
+  seq 12 frame 12 t 1403636579.763555584 state tracking valid 1 kf 0 unscaled 0 unanchored 0 world 3 quality 0.830
+  p <x y z> q <x y z w>   (one line)
 
 Usage: pose_client.py [--bind 0.0.0.0] [--port 9870] [--count N] [--timeout S]
 """
@@ -52,9 +53,9 @@ def format_pose(p):
     t = p["capture_time_ns"]
     whole = abs(t) // 1000000000  # truncated toward zero, as C's integer division
     seconds = "%d.%09d" % (-whole if t < 0 else whole, abs(t) % 1000000000)
-    return ("seq %d frame %d t %s state %s valid %d kf %d unscaled %d quality %.3f p %s q %s" % (
+    return ("seq %d frame %d t %s state %s valid %d kf %d unscaled %d unanchored %d world %d quality %.3f p %s q %s" % (
         p["sequence"], p["frame_sequence"], seconds, p["tracking"], p["valid"], p["keyframe"], p["unscaled"],
-        p["quality"],
+        p["unanchored"], p["world_revision"], p["quality"],
         " ".join("%.17g" % v for v in p["position"]), " ".join("%.17g" % v for v in p["orientation"])))
 
 

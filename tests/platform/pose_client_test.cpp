@@ -55,7 +55,10 @@ TEST(PoseClientPy, DecodesTheDaemonsDatagramsLikeTheCppTools) {
     r.orientation[2] = 0.5;
     r.orientation[3] = 0.5;
     r.tracking = static_cast<pose::Tracking>(i);
-    r.flags = static_cast<uint8_t>(i == 1 ? pose::kFlagValid : i == 2 ? pose::kFlagValid | pose::kFlagUnscaled : 0);
+    r.flags = static_cast<uint8_t>(i == 1   ? pose::kFlagValid
+                                   : i == 2 ? pose::kFlagValid | pose::kFlagUnscaled | pose::kFlagUnanchored
+                                            : 0);
+    r.world_revision = static_cast<uint16_t>(65535 * i / 2);
     r.quality = 0.25f * i;
   }
   // The client bound its socket before saying "listening", so nothing sent now is lost.
