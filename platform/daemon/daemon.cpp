@@ -174,8 +174,11 @@ DaemonStats Daemon::stats() const {
   s.pose_drops = processing_.poseDrops();
   s.udp_sent = publishing_.udp().sent();
   s.udp_failed = publishing_.udp().failed();
+  s.udp_errno = publishing_.udp().lastErrno();
   s.trajectory_poses = publishing_.trajectory().written();
   s.trajectory_errors = publishing_.trajectory().errors();
+  s.trajectory_reopened = publishing_.trajectory().reopened();
+  s.trajectory_errno = publishing_.trajectory().lastErrno();
   s.tracking = processing_.tracking();
   s.unscaled = processing_.unscaled();
   s.latency_count = publishing_.latency().count();

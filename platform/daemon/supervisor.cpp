@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
+#include <string>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 
@@ -37,11 +40,36 @@ void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char
 
 namespace {
 
+// A run of failures of an output (writes, sends) between two ticks, from its counters: worth one line when it
+// begins and one when the output works again, not one per failure.
+class FailureSpell {
+ public:
+  enum Change { Same, Began, Ended };
+  Change update(uint64_t failures, uint64_t successes) {
+    Change change = Same;
+    if (failures > failures_ && !failing_) {
+      change = Began;
+      failing_ = true;
+    } else if (failures == failures_ && successes > successes_ && failing_) {
+      change = Ended;
+      failing_ = false;
+    }
+    failures_ = failures;
+    successes_ = successes;
+    return change;
+  }
+
+ private:
+  uint64_t failures_ = 0, successes_ = 0;
+  bool failing_ = false;
+};
+
 // What the main loop watches between ticks: progress for the watchdog, and changes worth a log line.
 class Watch {
  public:
-  explicit Watch(double status_interval_s)
-      : status_ns_(static_cast<int64_t>(status_interval_s * 1e9)),
+  Watch(double status_interval_s, std::string trajectory_path)
+      : trajectory_path_(std::move(trajectory_path)),
+        status_ns_(static_cast<int64_t>(status_interval_s * 1e9)),
         last_progress_(monotonicNowNs()),
         last_status_(last_progress_) {}
 
@@ -54,19 +82,28 @@ class Watch {
     daemon.health(health, sizeof(health));
     watchdog(s, now, health, notifier);
     logChanges(s, health);
-    if (now - last_status_ >= status_ns_) {
-      const double rate =
-          static_cast<double>(s.processed - processed_at_status_) / (static_cast<double>(now - last_status_) * 1e-9);
-      char line[640];
-      formatStatus(s, rate, health, line, sizeof(line));
-      notifier.status(line);
-      spdlog::info("{}", line);
-      processed_at_status_ = s.processed;
-      last_status_ = now;
-    }
+    logOutputs(s);
+    if (now - last_status_ >= status_ns_) status(s, health, now, notifier);
+  }
+
+  void statusNow(const Daemon& daemon, SystemdNotifier& notifier) {
+    char health[128];
+    daemon.health(health, sizeof(health));
+    status(daemon.stats(), health, monotonicNowNs(), notifier);
   }
 
  private:
+  void status(const DaemonStats& s, const char* health, int64_t now, SystemdNotifier& notifier) {
+    const double seconds = static_cast<double>(now - last_status_) * 1e-9;
+    const double rate = seconds > 0 ? static_cast<double>(s.processed - processed_at_status_) / seconds : 0.0;
+    char line[640];
+    formatStatus(s, rate, health, line, sizeof(line));
+    notifier.status(line);
+    spdlog::info("{}", line);
+    processed_at_status_ = s.processed;
+    last_status_ = now;
+  }
+
   void watchdog(const DaemonStats& s, int64_t now, const char* health, SystemdNotifier& notifier) {
     const bool progress = s.processed > last_processed_;
     if (progress) {
@@ -98,6 +135,33 @@ class Watch {
     }
   }
 
+  // The trajectory file's and the UDP sends' troubles, once when they begin and once when they end.
+  void logOutputs(const DaemonStats& s) {
+    const std::string& path = trajectory_path_;
+    if (s.trajectory_reopened > trajectory_reopened_)
+      spdlog::warn("trajectory {} was removed while being written: made again (the poses before are gone with it)",
+                   path);
+    trajectory_reopened_ = s.trajectory_reopened;
+    switch (trajectory_.update(s.trajectory_errors, s.trajectory_poses)) {
+      case FailureSpell::Began:
+        spdlog::error("trajectory {}: poses cannot be written ({}); they are still published and are counted", path,
+                      std::strerror(s.trajectory_errno));
+        break;
+      case FailureSpell::Ended:
+        spdlog::info("trajectory {}: written again ({} poses missing from it so far)", path, s.trajectory_errors);
+        break;
+      case FailureSpell::Same: break;
+    }
+    switch (udp_.update(s.udp_failed, s.udp_sent)) {
+      case FailureSpell::Began:
+        spdlog::error("UDP: pose datagrams cannot be sent ({}); counted", std::strerror(s.udp_errno));
+        break;
+      case FailureSpell::Ended: spdlog::info("UDP: sending again ({} datagrams failed so far)", s.udp_failed); break;
+      case FailureSpell::Same: break;
+    }
+  }
+
+  std::string trajectory_path_;
   int64_t status_ns_;
   uint64_t last_processed_ = 0, processed_at_status_ = 0;
   int64_t last_progress_, last_status_;
@@ -105,19 +169,59 @@ class Watch {
   bool last_unscaled_ = false;
   uint64_t last_lost_ = 0;
   bool stall_reported_ = false;
+  uint64_t trajectory_reopened_ = 0;
+  FailureSpell trajectory_, udp_;
 };
 
-// Waits for SIGTERM/SIGINT (returned) or the end of a replay with at_end: exit (0), ticking the watch.
+bool stopsTheDaemon(int sig) { return sig == SIGTERM || sig == SIGINT || sig == SIGQUIT; }
+
+const char* signalName(int sig) {
+  switch (sig) {
+    case SIGTERM: return "SIGTERM";
+    case SIGINT: return "SIGINT";
+    case SIGQUIT: return "SIGQUIT";
+    case SIGHUP: return "SIGHUP";
+    case SIGUSR1: return "SIGUSR1";
+    case SIGUSR2: return "SIGUSR2";
+    default: return "a signal";
+  }
+}
+
+// The signals the main thread takes (blocked in every thread, taken with sigtimedwait): whatever their default
+// action, none of them ends the daemon without the clean stop (segment marked stopped, trajectory synced,
+// extrinsics written).
+sigset_t handledSignals() {
+  sigset_t set;
+  sigemptyset(&set);
+  for (int sig : {SIGTERM, SIGINT, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) sigaddset(&set, sig);
+  return set;
+}
+
+// A signal that does not stop the daemon: SIGUSR1 asks for the status line now; the others are logged and ignored
+// (the configuration is read at start only).
+void answerSignal(int sig, Watch& watch, const Daemon& daemon, SystemdNotifier& notifier) {
+  if (sig == SIGUSR1) {
+    watch.statusNow(daemon, notifier);
+    return;
+  }
+  spdlog::warn(
+      "{} ignored: mcslamd does not reload its configuration (restart it to apply a change; SIGTERM stops "
+      "it, SIGUSR1 logs its status)",
+      signalName(sig));
+}
+
+// Waits for a stopping signal (returned) or the end of a replay with at_end: exit (0), ticking the watch.
 int superviseUntilStop(const DaemonConfig& config, const Daemon& daemon, SystemdNotifier& notifier,
-                       const sigset_t& stop_signals) {
+                       const sigset_t& signals) {
   const int64_t status_ns = static_cast<int64_t>(config.status_interval_s * 1e9);
   const int64_t watchdog_ns = notifier.watchdogIntervalUs() * 1000 / 2;
   const int64_t tick_ns = watchdog_ns > 0 ? std::min(status_ns, watchdog_ns) : status_ns;
-  Watch watch(config.status_interval_s);
+  Watch watch(config.status_interval_s, daemon.trajectoryPath());
   for (;;) {
     timespec timeout{static_cast<time_t>(tick_ns / 1000000000), static_cast<long>(tick_ns % 1000000000)};
-    const int sig = sigtimedwait(&stop_signals, nullptr, &timeout);
-    if (sig == SIGTERM || sig == SIGINT) return sig;
+    const int sig = sigtimedwait(&signals, nullptr, &timeout);
+    if (sig > 0 && stopsTheDaemon(sig)) return sig;
+    if (sig > 0) answerSignal(sig, watch, daemon, notifier);
     watch.tick(daemon, notifier);
     if (exitsAtEnd(config) && daemon.drained()) {
       spdlog::info("source finished (at_end: exit): stopping");
@@ -129,13 +233,10 @@ int superviseUntilStop(const DaemonConfig& config, const Daemon& daemon, Systemd
 }  // namespace
 
 int runDaemon(const DaemonConfig& config) {
-  // Block the stop signals before any thread exists, so every thread inherits the mask and only this
-  // one receives them (sigtimedwait).
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGTERM);
-  sigaddset(&stop_signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  // Block the signals before any thread exists, so every thread inherits the mask and only this one receives
+  // them (sigtimedwait).
+  const sigset_t signals = handledSignals();
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   SystemdNotifier notifier;
   Daemon daemon(config, createPipeline(config.slam, config.file, config.rig, /*live=*/true));
@@ -144,10 +245,10 @@ int runDaemon(const DaemonConfig& config) {
   spdlog::info("mcslamd: running ({} cameras, source {}, trigger {}, trajectory {}){}", config.rig.size(),
                configName(config.source_type), configName(config.trigger.mode), daemon.trajectoryPath(),
                notifier.enabled() ? ", systemd notified" : "");
-  const int signal_number = superviseUntilStop(config, daemon, notifier, stop_signals);
+  const int signal_number = superviseUntilStop(config, daemon, notifier, signals);
 
   notifier.stopping();
-  if (signal_number) spdlog::info("{}: stopping", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+  if (signal_number) spdlog::info("{}: stopping", signalName(signal_number));
   const bool clean = daemon.stop();
   const DaemonStats s = daemon.stats();
   spdlog::info(
@@ -156,7 +257,10 @@ int runDaemon(const DaemonConfig& config) {
       s.processed, s.published, s.trajectory_poses, daemon.trajectoryPath(), s.rig_drops, s.camera_drops,
       s.partial_frames, s.bad_frames, s.allocations_after_warmup, s.frames_after_warmup, alloc::totalCount());
   if (!clean) spdlog::error("the pipeline did not finish its frame within the grace period");
-  return clean ? 0 : 1;
+  if (s.trajectory_errors > 0)
+    spdlog::error("trajectory {}: {} poses or syncs failed (last: {}); the file holds whole lines only",
+                  daemon.trajectoryPath(), s.trajectory_errors, std::strerror(s.trajectory_errno));
+  return clean && s.trajectory_errors == 0 ? 0 : 1;
 }
 
 }  // namespace mcslam::platform

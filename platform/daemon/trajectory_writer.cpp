@@ -41,23 +41,72 @@ int formatTumLine(const pose::PoseRecord& r, char* out) {
 TrajectoryWriter::TrajectoryWriter(const std::string& path) : path_(path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && st.st_size > 0) ::rename(path.c_str(), (path + ".previous").c_str());
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
-  if (fd_ < 0)
+  if (!openFile(O_TRUNC) && fd_ < 0)
     throw InputError("output.trajectory: cannot create '" + path + "': " + std::strerror(errno) +
                      " (check output.directory or $STATE_DIRECTORY)");
+}
+
+bool TrajectoryWriter::openFile(int flags) {
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | flags, 0644);
+  if (fd_ < 0) return false;
+  whole_lines_size_ = 0;
   const char header[] = "# mcslamd trajectory (TUM): t[s] tx ty tz qx qy qz qw, T_w_b\n";
-  if (::write(fd_, header, sizeof(header) - 1) < 0) ++errors_;
+  const int n = static_cast<int>(sizeof(header) - 1);
+  if (writeAll(header, n)) {
+    whole_lines_size_ = n;
+    return true;
+  }
+  fail(errno);
+  return false;
+}
+
+bool TrajectoryWriter::writeAll(const char* bytes, int n) {
+  // A short write is followed by another for the rest, which either completes the line or says why it cannot.
+  int done = 0;
+  while (done < n) {
+    const ssize_t w = ::write(fd_, bytes + done, static_cast<std::size_t>(n - done));
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      if (w == 0) errno = EIO;
+      return false;
+    }
+    done += static_cast<int>(w);
+  }
+  return true;
+}
+
+void TrajectoryWriter::fail(int err) {
+  last_errno_.store(err ? err : EIO, std::memory_order_relaxed);
+  errors_.fetch_add(1, std::memory_order_relaxed);
+  if (fd_ >= 0) (void)::ftruncate(fd_, whole_lines_size_);  // no torn line (fails harmlessly on a device)
+}
+
+bool TrajectoryWriter::ensureFileExists() {
+  struct stat st {};
+  if (fd_ >= 0 && ::fstat(fd_, &st) == 0 && st.st_nlink > 0) return true;
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  if (!openFile(0)) {
+    if (fd_ < 0) last_errno_.store(errno, std::memory_order_relaxed);
+    return false;
+  }
+  reopened_.fetch_add(1, std::memory_order_relaxed);
+  return true;
 }
 
 bool TrajectoryWriter::append(const pose::PoseRecord& r) {
-  if (fd_ < 0) return false;
-  char line[256];
-  const int n = formatTumLine(r, line);
-  if (::write(fd_, line, static_cast<std::size_t>(n)) != n) {
-    ++errors_;
+  if (!ensureFileExists()) {
+    errors_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  ++written_;
+  char line[256];
+  const int n = formatTumLine(r, line);
+  if (!writeAll(line, n)) {
+    fail(errno);
+    return false;
+  }
+  whole_lines_size_ += n;
+  written_.fetch_add(1, std::memory_order_relaxed);
   return true;
 }
 
@@ -65,7 +114,7 @@ bool TrajectoryWriter::sync() { return fd_ >= 0 && ::fsync(fd_) == 0; }
 
 void TrajectoryWriter::close() {
   if (fd_ < 0) return;
-  if (!sync()) ++errors_;
+  if (!sync()) fail(errno);
   ::close(fd_);
   fd_ = -1;
 }

@@ -50,6 +50,9 @@ UdpPoseSender::UdpPoseSender(std::vector<UdpDestination> destinations) : destina
     if (s < 0)
       throw InputError("publish.udp.destinations: cannot create a socket for '" + d.text +
                        "': " + std::strerror(errno));
+    // A broadcast destination (a subnet's .255, 255.255.255.255) is refused with EACCES without it.
+    const int on = 1;
+    if (d.address.ss_family == AF_INET) ::setsockopt(s, SOL_SOCKET, SO_BROADCAST, &on, sizeof(on));
   }
 }
 
@@ -68,8 +71,10 @@ void UdpPoseSender::send(const pose::PoseRecord& record) {
                                reinterpret_cast<const sockaddr*>(&d.address), d.length);
     if (n == static_cast<ssize_t>(sizeof(bytes)))
       sent_.fetch_add(1, std::memory_order_relaxed);
-    else
+    else {
+      last_errno_.store(n < 0 ? errno : EMSGSIZE, std::memory_order_relaxed);
       failed_.fetch_add(1, std::memory_order_relaxed);
+    }
   }
 }
 

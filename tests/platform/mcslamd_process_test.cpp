@@ -87,7 +87,7 @@ class NotifyListener {
 
 pid_t spawnDaemon(const std::string& config, const std::string& notify, const std::string& watchdog_usec,
                   const std::string& log) {
-  const pid_t pid = ::fork();
+  const pid_t pid = test::forkDyingWithParent();
   if (pid == 0) {
     ::setenv("NOTIFY_SOCKET", notify.c_str(), 1);
     ::setenv("WATCHDOG_USEC", watchdog_usec.c_str(), 1);
@@ -333,6 +333,39 @@ TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
   EXPECT_EQ(notify.count("WATCHDOG=1"), 0) << "watchdog kept alive without progress";
   ::kill(pid, SIGINT);
   EXPECT_EQ(waitExit(pid, 20), 0) << readAll(dir.file("log.txt"));
+}
+
+// Signals other than the stopping ones neither kill the daemon (their default action) nor stop it; SIGQUIT stops it
+// as SIGTERM does, through the clean stop.
+TEST(McslamdProcess, OtherSignalsAreAnsweredAndSigquitStopsCleanly) {
+  test::TempDir dir("mcslamd-signals");
+  const std::string data = test::writeSmallDataset(dir.file("data"), 2, 5);
+  NotifyListener notify(dir.file("notify.sock"));
+  ASSERT_TRUE(notify.ok());
+  const std::string config =
+      test::writeFile(dir.file("mcslamd.yaml"),
+                      "status_interval_s: 1000\nsource:\n  type: dataset\n  dataset:\n    path: data\n"
+                      "trigger:\n  mode: software\n  rate_hz: 0.1\n"
+                      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
+  const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "0", dir.file("log.txt"));
+  const ReapOnExit reap_pid(pid);
+  ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));
+  ::kill(pid, SIGHUP);
+  ::kill(pid, SIGUSR2);
+  ASSERT_TRUE(waitFor([&] { return readAll(dir.file("log.txt")).find("SIGUSR2 ignored") != std::string::npos; }))
+      << readAll(dir.file("log.txt"));
+  EXPECT_NE(readAll(dir.file("log.txt")).find("SIGHUP ignored"), std::string::npos);
+  const int status_lines = notify.count("STATUS=");  // none from the timer: its interval is 1000 s
+  ::kill(pid, SIGUSR1);
+  ASSERT_TRUE(waitFor([&] { return notify.count("STATUS=") > status_lines; })) << readAll(dir.file("log.txt"));
+  int status = 0;
+  EXPECT_EQ(::waitpid(pid, &status, WNOHANG), 0) << "a signal ended the daemon";
+  ::kill(pid, SIGQUIT);
+  EXPECT_EQ(waitExit(pid, 20), 0) << readAll(dir.file("log.txt"));
+  const std::string log = readAll(dir.file("log.txt"));
+  EXPECT_NE(log.find("SIGQUIT: stopping"), std::string::npos) << log;
+  EXPECT_NE(log.find("stopped:"), std::string::npos) << log;
+  EXPECT_EQ(notify.count("STOPPING=1"), 1);
 }
 
 TEST(McslamdProcess, ImageCodecIsMappedOnlyWhenTheReplayMeetsAPng) {

@@ -1,13 +1,19 @@
 // sd_notify datagrams, UDP pose datagrams, the TUM trajectory writer and pixel conversion.
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "aravis/pixel_convert.hpp"
 #include "daemon/trajectory_writer.hpp"
@@ -95,6 +101,30 @@ TEST(UdpPoseSender, EveryDestinationGetsOneDecodableDatagramPerPose) {
   ::close(rx);
 }
 
+// A broadcast destination needs SO_BROADCAST (without it every send fails with EACCES): loopback's broadcast
+// address reaches a socket bound to any address.
+TEST(UdpPoseSender, ABroadcastDestinationIsSentTo) {
+  const int rx = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_ANY);
+  ASSERT_EQ(::bind(rx, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+  socklen_t len = sizeof(a);
+  ::getsockname(rx, reinterpret_cast<sockaddr*>(&a), &len);
+  timeval tv{5, 0};
+  ::setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+  const std::string dest = "127.255.255.255:" + std::to_string(ntohs(a.sin_port));
+  UdpPoseSender sender({resolveUdpDestination(dest, "publish.udp.destinations")});
+  pose::PoseRecord r;
+  r.sequence = 7;
+  sender.send(r);
+  EXPECT_EQ(sender.failed(), 0u) << std::strerror(sender.lastErrno());
+  EXPECT_EQ(sender.sent(), 1u);
+  uint8_t buf[256];
+  EXPECT_EQ(::recv(rx, buf, sizeof(buf), 0), static_cast<ssize_t>(pose::kPacketSize));
+  ::close(rx);
+}
+
 TEST(UdpPoseSender, BadDestinationsNameTheKeyAndTheText) {
   for (const char* bad : {"localhost", "127.0.0.1:0", "127.0.0.1:99999", "no-such-host.invalid:9000", "[::1]9000"}) {
     try {
@@ -153,6 +183,107 @@ TEST(TrajectoryWriter, UnwritablePathNamesTheKey) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("output.trajectory"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+pose::PoseRecord recordAt(int i) {
+  pose::PoseRecord r;
+  r.capture_time_ns = 1000000000ll * (i + 1);
+  r.position[0] = 0.25 * i;
+  r.orientation[3] = 1;
+  return r;
+}
+
+// Every line of the file, and whether the last one ends with its newline.
+std::vector<std::string> fileLines(const std::string& path, bool* ends_with_newline) {
+  const std::string text = test::readFile(path);
+  *ends_with_newline = text.empty() || text.back() == '\n';
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// The process's file size limit for one scope: a write across it is cut short (the way a full disk cuts it) and
+// fails with EFBIG after it; SIGXFSZ, which would end the process, is ignored meanwhile.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    ::getrlimit(RLIMIT_FSIZE, &saved_);
+    previous_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, previous_handler_);
+  }
+
+ private:
+  rlimit saved_{};
+  void (*previous_handler_)(int) = nullptr;
+};
+}  // namespace
+
+// A full disk cuts a pose's line short: the writer counts the pose, keeps the reason and cuts the file back to
+// its last whole line, so that once space returns the next pose starts a line of its own.
+TEST(TrajectoryWriter, AFullDiskLeavesNoTornLineAndWritingGoesOnWhenSpaceReturns) {
+  test::TempDir dir("traj-full");
+  const std::string path = dir.file("trajectory.tum");
+  TrajectoryWriter w(path);
+  ASSERT_TRUE(w.append(recordAt(0)));
+  const auto whole = static_cast<rlim_t>(test::readFile(path).size());
+  {
+    const FileSizeLimit limit(whole + 10);  // room for 10 bytes of the next line
+    EXPECT_FALSE(w.append(recordAt(1)));
+    EXPECT_FALSE(w.append(recordAt(2)));
+  }
+  EXPECT_EQ(w.errors(), 2u);
+  EXPECT_EQ(w.lastErrno(), EFBIG);
+  EXPECT_EQ(test::readFile(path).size(), whole) << "the torn line is cut off";
+  ASSERT_TRUE(w.append(recordAt(3)));
+  EXPECT_TRUE(w.sync());
+  bool newline = false;
+  const std::vector<std::string> lines = fileLines(path, &newline);
+  EXPECT_TRUE(newline);
+  ASSERT_EQ(lines.size(), 3u);  // the header, pose 0, pose 3
+  EXPECT_EQ(lines[1].rfind("1.000000000 ", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[2].rfind("4.000000000 0.75 ", 0), 0u) << lines[2];
+  EXPECT_EQ(w.written(), 2u);
+}
+
+TEST(TrajectoryWriter, OnADeviceThatIsAlwaysFullEveryPoseCountsAsAnError) {
+  if (::access("/dev/full", W_OK) != 0) GTEST_SKIP() << "/dev/full is not writable here";
+  TrajectoryWriter w("/dev/full");
+  EXPECT_FALSE(w.append(recordAt(0)));
+  EXPECT_EQ(w.lastErrno(), ENOSPC);
+  EXPECT_EQ(w.errors(), 2u);  // the header and the pose
+  EXPECT_EQ(w.written(), 0u);
+}
+
+// A trajectory file removed while it is written (its folder cleaned up) is made again at the same path; with its
+// folder gone too, each pose counts as an error until the folder is back.
+TEST(TrajectoryWriter, ARemovedFileIsMadeAgainAndAMissingFolderCountsEachPose) {
+  test::TempDir dir("traj-removed");
+  const std::string folder = dir.file("out");
+  std::filesystem::create_directories(folder);
+  const std::string path = folder + "/trajectory.tum";
+  TrajectoryWriter w(path);
+  ASSERT_TRUE(w.append(recordAt(0)));
+  std::filesystem::remove_all(folder);
+  EXPECT_FALSE(w.append(recordAt(1)));
+  EXPECT_FALSE(w.append(recordAt(2)));
+  EXPECT_EQ(w.errors(), 2u);
+  EXPECT_EQ(w.lastErrno(), ENOENT);
+  std::filesystem::create_directories(folder);
+  ASSERT_TRUE(w.append(recordAt(3)));
+  EXPECT_EQ(w.reopened(), 1u);
+  bool newline = false;
+  const std::vector<std::string> lines = fileLines(path, &newline);
+  ASSERT_EQ(lines.size(), 2u);  // a header and pose 3
+  EXPECT_EQ(lines[0][0], '#');
+  EXPECT_EQ(lines[1].rfind("4.000000000 ", 0), 0u) << lines[1];
 }
 
 TEST(PixelConvert, BayerPatternsGiveTheGreyOfTheirColour) {

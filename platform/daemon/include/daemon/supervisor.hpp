@@ -1,5 +1,5 @@
 #pragma once
-// The daemon's main thread: builds the Daemon, tells systemd READY=1, then until SIGTERM/SIGINT (or the
+// The daemon's main thread: builds the Daemon, tells systemd READY=1, then until SIGTERM/SIGINT/SIGQUIT (or the
 // end of a replay with at_end: exit) sends STATUS= and WATCHDOG=1 (only while frames are being
 // processed), logs statistics and state changes, and finally stops everything within 2 s.
 #include "daemon/daemon_config.hpp"

@@ -33,12 +33,14 @@ class UdpPoseSender {
   void send(const pose::PoseRecord& record);
   uint64_t sent() const { return sent_.load(std::memory_order_relaxed); }
   uint64_t failed() const { return failed_.load(std::memory_order_relaxed); }
+  int lastErrno() const { return last_errno_.load(std::memory_order_relaxed); }  // of the last failed send
   const std::vector<UdpDestination>& destinations() const { return destinations_; }
 
  private:
   std::vector<UdpDestination> destinations_;
   int socket4_ = -1, socket6_ = -1;
   std::atomic<uint64_t> sent_{0}, failed_{0};
+  std::atomic<int> last_errno_{0};
 };
 
 }  // namespace mcslam::platform
