@@ -64,6 +64,7 @@ TEST(PoseShmRobustDeathTest, TheWriterSurvivesATruncationAndSaysSo) {
         std::_Exit(reader.open(name) ? 12 : 0);
       },
       ::testing::ExitedWithCode(0), "");
+  ::shm_unlink(name.c_str());  // in case the child failed before its stop
 }
 
 TEST(PoseShmRobustDeathTest, AGuardedReaderSurvivesATruncationAndSeesIt) {
@@ -82,6 +83,7 @@ TEST(PoseShmRobustDeathTest, AGuardedReaderSurvivesATruncationAndSeesIt) {
         std::_Exit(reader.check() == SegmentStatus::Truncated ? 0 : 14);
       },
       ::testing::ExitedWithCode(0), "");
+  ::shm_unlink(name.c_str());  // the child ended without its writer's stop
 }
 
 TEST(PoseShmRobust, ANameARunningWriterHoldsIsRefusedWithItsPid) {
