@@ -11,7 +11,11 @@
 // even means the copy is whole. This is correct under the C++ memory model, so on ARM as well as x86
 // (Boehm, "Can seqlocks get along with programming language memory models?", 2012). The segment is
 // mapped read-only: a reader only loads.
+//
+// A writer that crashes leaves its segment saying "running"; the restarted writer makes a new one under
+// the same name. check() tells a reader which case it is in, reattach() follows the name.
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -22,6 +26,7 @@
 #include <string>
 
 #include "mcslam/pose_protocol.hpp"
+#include "mcslam/pose_shm_guard.hpp"
 
 namespace mcslam::pose {
 
@@ -94,6 +99,18 @@ inline void seqlockWrite(ShmSlot& slot, const uint8_t in[kPacketSize]) {
 
 enum class ReadStatus { Ok, NotYet, Overwritten, Busy };
 
+// What check() found (docs/pose-protocol.md, "staying attached").
+enum class SegmentStatus {
+  Live,        // the writer runs and the name still leads to this segment
+  Stopped,     // the writer stopped cleanly (state = stopped)
+  WriterGone,  // the writer process no longer exists (it crashed or was killed)
+  Replaced,    // the name now leads to another segment (a restarted writer): reattach()
+  NameGone,    // the name was removed and nothing replaced it (yet)
+  Truncated,   // someone shrank the segment: its contents are gone
+  NotOpen,
+};
+const char* segmentStatusName(SegmentStatus s);
+
 class PoseShmReader {
  public:
   PoseShmReader() = default;
@@ -101,11 +118,15 @@ class PoseShmReader {
   PoseShmReader& operator=(const PoseShmReader&) = delete;
   ~PoseShmReader() { close(); }
 
+  // Makes a truncated segment read as zeros (check() then says Truncated) instead of ending the process
+  // with SIGBUS: installs a process-wide SIGBUS handler (pose_shm_guard.hpp). Call once, before reading.
+  static bool guardAgainstTruncation() { return shm_guard::install(); }
+
   // Maps the segment read-only. False (and *error) when it is missing, too small or not a version-1
   // mcslam pose segment.
   bool open(const std::string& name, std::string* error = nullptr) {
     close();
-    const int fd = ::shm_open(name.c_str(), O_RDONLY, 0);
+    const int fd = ::shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0);
     if (fd < 0) return fail(error, "shm_open(" + name + "): " + std::strerror(errno));
     struct stat st {};
     if (::fstat(fd, &st) != 0 || static_cast<std::size_t>(st.st_size) < shmSegmentSize(0)) {
@@ -113,30 +134,62 @@ class PoseShmReader {
       return fail(error, name + ": segment too small (the writer may still be creating it)");
     }
     void* p = ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0);
-    ::close(fd);
-    if (p == MAP_FAILED) return fail(error, "mmap(" + name + "): " + std::strerror(errno));
+    if (p == MAP_FAILED) {
+      ::close(fd);
+      return fail(error, "mmap(" + name + "): " + std::strerror(errno));
+    }
     base_ = static_cast<const uint8_t*>(p);
     size_ = static_cast<std::size_t>(st.st_size);
-    const ShmHeader& h = header();
-    if (h.magic.load(std::memory_order_acquire) != kShmMagic)
-      return failClose(error, name + ": not an mcslam pose segment (magic)");
-    if (h.version != kShmVersion) return failClose(error, name + ": unsupported version " + std::to_string(h.version));
-    if (h.record_size != kPacketSize || h.slot_size != kShmSlotSize || h.header_size != kShmHeaderSize ||
-        h.ring_offset != kShmHeaderSize + kShmSlotSize || shmSegmentSize(h.ring_capacity) > size_ ||
-        h.ring_capacity == 0)
-      return failClose(error, name + ": inconsistent header");
-    return true;
+    fd_ = fd;
+    dev_ = st.st_dev;
+    ino_ = st.st_ino;
+    guard_ = shm_guard::add(base_, size_, PROT_READ);
+    name_ = name;
+    return validate(error);
+  }
+
+  // Opens the segment the name leads to now (after Replaced, WriterGone or NameGone).
+  bool reattach(std::string* error = nullptr) {
+    const std::string name = name_;
+    return open(name, error);
   }
 
   void close() {
+    shm_guard::remove(guard_);
+    guard_ = -1;
     if (base_) ::munmap(const_cast<uint8_t*>(base_), size_);
+    if (fd_ >= 0) ::close(fd_);
     base_ = nullptr;
     size_ = 0;
+    fd_ = -1;
   }
   bool isOpen() const { return base_ != nullptr; }
+  const std::string& name() const { return name_; }
+
+  // Whether this segment is still the one to read: a few system calls (fstat, kill(pid, 0), shm_open,
+  // fstat, close), no allocation. Call it now and then, e.g. when no new pose came for a while.
+  SegmentStatus check() const {
+    if (!isOpen()) return SegmentStatus::NotOpen;
+    struct stat st {};
+    if (shm_guard::lost(guard_) || (::fstat(fd_, &st) == 0 && static_cast<std::size_t>(st.st_size) < size_))
+      return SegmentStatus::Truncated;
+    if (header().state.load(std::memory_order_acquire) == kWriterStopped) return SegmentStatus::Stopped;
+    // The name first: a restarted writer made a new segment, whatever became of the old writer's pid.
+    const int fd = ::shm_open(name_.c_str(), O_RDONLY | O_CLOEXEC, 0);
+    if (fd < 0 && errno == ENOENT) return SegmentStatus::NameGone;
+    if (fd < 0 && errno == EACCES) return SegmentStatus::Replaced;  // another user's file now
+    if (fd >= 0) {  // (EMFILE and the like tell nothing about the segment)
+      const bool same = ::fstat(fd, &st) == 0 && st.st_dev == dev_ && st.st_ino == ino_;
+      ::close(fd);
+      if (!same) return SegmentStatus::Replaced;
+    }
+    const pid_t pid = static_cast<pid_t>(writerPid());
+    if (pid <= 0 || (::kill(pid, 0) != 0 && errno == ESRCH)) return SegmentStatus::WriterGone;
+    return SegmentStatus::Live;
+  }
 
   const ShmHeader& header() const { return *reinterpret_cast<const ShmHeader*>(base_); }
-  uint32_t ringCapacity() const { return header().ring_capacity; }
+  uint32_t ringCapacity() const { return capacity_; }
   uint64_t published() const { return header().published.load(std::memory_order_acquire); }
   bool writerRunning() const { return header().state.load(std::memory_order_acquire) == kWriterRunning; }
   int64_t writerPid() const { return header().writer_pid; }
@@ -155,17 +208,34 @@ class PoseShmReader {
     if (seq == 0 || seq > newest) return ReadStatus::NotYet;
     if (newest - seq >= ringCapacity()) return ReadStatus::Overwritten;
     uint8_t bytes[kPacketSize];
-    if (!seqlockRead(ringSlot(seq), bytes)) return ReadStatus::Busy;
+    if (!seqlockRead(ringSlot(seq), bytes)) {
+      // A slot never written although `published` covers it: this segment never had the record (a writer
+      // that made a new segment mid-run goes on with its sequence).
+      return ringSlot(seq).seq.load(std::memory_order_acquire) == 0 ? ReadStatus::Overwritten : ReadStatus::Busy;
+    }
     if (decodePacket(bytes, kPacketSize, out) != DecodeStatus::Ok) return ReadStatus::Busy;
     return out.sequence == seq ? ReadStatus::Ok : ReadStatus::Overwritten;
   }
 
   const ShmSlot& latestSlot() const { return *reinterpret_cast<const ShmSlot*>(base_ + kShmHeaderSize); }
+  // Offsets from the header as validated at open: a header rewritten later cannot lead outside the mapping.
   const ShmSlot& ringSlot(uint64_t seq) const {
-    return *reinterpret_cast<const ShmSlot*>(base_ + header().ring_offset + (seq % ringCapacity()) * kShmSlotSize);
+    return *reinterpret_cast<const ShmSlot*>(base_ + kShmHeaderSize + kShmSlotSize + (seq % capacity_) * kShmSlotSize);
   }
 
  private:
+  bool validate(std::string* error) {
+    const ShmHeader& h = header();
+    if (h.magic.load(std::memory_order_acquire) != kShmMagic)
+      return failClose(error, name_ + ": not an mcslam pose segment (magic)");
+    if (h.version != kShmVersion) return failClose(error, name_ + ": unsupported version " + std::to_string(h.version));
+    if (h.record_size != kPacketSize || h.slot_size != kShmSlotSize || h.header_size != kShmHeaderSize ||
+        h.ring_offset != kShmHeaderSize + kShmSlotSize || shmSegmentSize(h.ring_capacity) > size_ ||
+        h.ring_capacity == 0)
+      return failClose(error, name_ + ": inconsistent header");
+    capacity_ = h.ring_capacity;
+    return true;
+  }
   static bool fail(std::string* error, const std::string& why) {
     if (error) *error = why;
     return false;
@@ -177,6 +247,25 @@ class PoseShmReader {
 
   const uint8_t* base_ = nullptr;
   std::size_t size_ = 0;
+  uint32_t capacity_ = 1;
+  int fd_ = -1;
+  dev_t dev_ = 0;
+  ino_t ino_ = 0;
+  int guard_ = -1;
+  std::string name_;
 };
+
+inline const char* segmentStatusName(SegmentStatus s) {
+  switch (s) {
+    case SegmentStatus::Live: return "live";
+    case SegmentStatus::Stopped: return "stopped";
+    case SegmentStatus::WriterGone: return "writer gone";
+    case SegmentStatus::Replaced: return "replaced";
+    case SegmentStatus::NameGone: return "name gone";
+    case SegmentStatus::Truncated: return "truncated";
+    case SegmentStatus::NotOpen: return "not open";
+  }
+  return "?";
+}
 
 }  // namespace mcslam::pose

@@ -12,6 +12,7 @@
 #include "mcslam/pipeline/pipeline_factory.hpp"
 #include "mcslam/sim/rig_presets.hpp"
 #include "mcslam/sim/world.hpp"
+#include "shm/pose_shm_writer.hpp"
 #include "udp/udp_pose_sender.hpp"
 
 namespace mcslam::platform {
@@ -159,6 +160,7 @@ void readPublish(const YamlFields& pub, PublishConfig& p) {
   if (p.shm_name.size() < 2 || p.shm_name[0] != '/' || p.shm_name.find('/', 1) != std::string::npos)
     shm.fail("name", "'" + p.shm_name + "' must be '/' followed by a name without '/'");
   p.shm_mode = shm.permissions("mode", p.shm_mode);
+  if (const std::string why = shmModeProblem(p.shm_mode); !why.empty()) shm.fail("mode", why);
   p.shm_ring_length = shm.capacity("ring_length", p.shm_ring_length, 1u << 20);
   const YamlFields udp = pub.child("udp");
   udp.allowOnly({"destinations"});

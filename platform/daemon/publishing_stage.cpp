@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include <spdlog/spdlog.h>
+
 #include "realtime/scheduling.hpp"
 
 namespace mcslam::platform {
@@ -35,7 +37,7 @@ std::string outputPathFor(const DaemonConfig& c, const std::string& name) {
 }
 
 PublishingStage::PublishingStage(const DaemonConfig& config, PoseRing& in, const WarmUp& warm_up)
-    : in_(in), warm_up_(warm_up), udp_(destinationsOf(config)) {
+    : in_(in), warm_up_(warm_up), udp_(destinationsOf(config)), shm_config_(config.publish) {
   if (config.publish.shm_enabled)
     shm_ = std::make_unique<PoseShmWriter>(config.publish.shm_name, config.publish.shm_ring_length,
                                            config.publish.shm_mode);
@@ -75,10 +77,29 @@ void PublishingStage::publish(const PoseSlot& slot) {
   r.quality = e.quality;
   r.world_revision = e.world_revision;
   if (shm_) shm_->publish(r);
+  if (shm_ && shm_->lost()) replaceLostShm();
   udp_.send(r);
   if (slot.trigger_mono_ns > 0) latency_.record(monotonicNowNs() - slot.trigger_mono_ns);
   if (r.valid()) trajectory_->append(r);
   published_.store(r.sequence, std::memory_order_release);
+}
+
+// Someone truncated the segment (the SIGBUS guard kept this thread alive): a new one, so that readers can
+// reattach (their check() says Truncated, then Replaced). Rare, so it may allocate and log.
+void PublishingStage::replaceLostShm() {
+  const std::string name = shm_->name();
+  shm_->markStopped();
+  shm_.reset();
+  ++shm_replacements_;
+  try {
+    shm_ = std::make_unique<PoseShmWriter>(name, shm_config_.shm_ring_length, shm_config_.shm_mode);
+    spdlog::error("publish.shm: '{}' was truncated by another process; published in a new segment from now on", name);
+  } catch (const std::exception& e) {
+    spdlog::error(
+        "publish.shm: '{}' was truncated by another process and cannot be made anew ({}); no more poses "
+        "in shared memory",
+        name, e.what());
+  }
 }
 
 void PublishingStage::run() {

@@ -9,7 +9,8 @@ function(run)
   message("${out}")
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
-foreach(f include/mcslam/pose_protocol.hpp include/mcslam/pose_shm.hpp lib/systemd/system/mcslamd.service
+foreach(f include/mcslam/pose_protocol.hpp include/mcslam/pose_shm.hpp include/mcslam/pose_shm_guard.hpp
+          lib/systemd/system/mcslamd.service
           bin/mcslamd)
   if(NOT EXISTS ${WORK_DIR}/prefix/${f})
     message(FATAL_ERROR "the install has no ${f}")

@@ -10,6 +10,7 @@
 #include "daemon/daemon_config.hpp"
 #include "daemon/supervisor.hpp"
 #include "mcslam/core/error.hpp"
+#include "shm/pose_shm_writer.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"mcslamd: multi-camera visual SLAM daemon (poses over shared memory and UDP)"};
@@ -41,5 +42,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "mcslamd: %s\n", e.what());
     std::fflush(stdout);
     return 2;
+  } catch (const mcslam::platform::ResourceBusyError& e) {
+    // Someone else holds what we need; unlike a bad configuration, a restart may find it released.
+    std::fprintf(stderr, "mcslamd: %s\n", e.what());
+    std::fflush(stdout);
+    return 3;
   }
 }

@@ -34,15 +34,20 @@ class PublishingStage {
   const TrajectoryWriter& trajectory() const { return *trajectory_; }
   const LatencyHistogram& latency() const { return latency_; }
   uint64_t allocationsSinceWarmup() const { return meter_.since(); }
+  // Segments made anew because someone truncated the previous one.
+  uint64_t shmReplacements() const { return shm_replacements_.load(std::memory_order_relaxed); }
 
  private:
   void run();
   void publish(const PoseSlot& slot);
+  void replaceLostShm();
 
   PoseRing& in_;
   const WarmUp& warm_up_;
   UdpPoseSender udp_;
+  PublishConfig shm_config_;
   std::unique_ptr<PoseShmWriter> shm_;
+  std::atomic<uint64_t> shm_replacements_{0};
   std::unique_ptr<TrajectoryWriter> trajectory_;
   LatencyHistogram latency_;
   std::atomic<bool> stop_{false};

@@ -1,0 +1,121 @@
+// mcslam-shm-echo when the segment misbehaves: a dead writer ends the wait with a message (it used to wait
+// forever), an inconsistent header ends it with one message (it used to print millions of lines), a truncated
+// segment does not kill it with SIGBUS, and a segment replaced under it (a restarted writer) is followed.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "child_process.hpp"
+#include "shm/pose_shm_writer.hpp"
+#include "shm_test_segments.hpp"
+#include "test_support.hpp"
+
+using namespace mcslam;
+
+namespace {
+pose::PoseRecord recordFor(uint64_t seq) {
+  pose::PoseRecord r;
+  r.sequence = seq;
+  r.orientation[3] = 1;
+  r.position[0] = static_cast<double>(seq);
+  return r;
+}
+
+int lineCount(const std::string& text) {
+  int n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
+// The `seq` of every printed pose.
+std::vector<uint64_t> sequencesIn(const std::string& out) {
+  std::vector<uint64_t> seqs;
+  std::istringstream in(out);
+  std::string word;
+  while (in >> word)
+    if (word == "seq" && in >> word) seqs.push_back(std::stoull(word));
+  return seqs;
+}
+
+// `timeout` and `ulimit -f` bound the run for the old behaviour (waiting or printing for ever); not a measurement.
+std::string echoCommand(const std::string& name, const std::string& args) {
+  return "(ulimit -f 10000; timeout 60 " + test::binPath("mcslam-shm-echo") + " --name " + name + " " + args + ")";
+}
+}  // namespace
+
+TEST(ShmEcho, ADeadWriterEndsTheWaitWithAMessage) {
+  const std::string name = test::uniqueShmName("echo-dead");
+  ASSERT_TRUE(test::makeSegment(name, test::deadPid(), 0));
+  std::string out;
+  EXPECT_EQ(test::runCommand(echoCommand(name, "--wait 0.2"), &out), 1) << out;
+  EXPECT_NE(out.find("writer gone"), std::string::npos) << out;
+  ::shm_unlink(name.c_str());
+}
+
+TEST(ShmEcho, AnInconsistentSegmentEndsWithOneMessage) {
+  const std::string name = test::uniqueShmName("echo-garbage");
+  // `published` far ahead, every slot garbage with an even (complete) sequence word; the writer (us) alive.
+  ASSERT_TRUE(test::makeSegment(name, ::getpid(), 1000000, 8, 0x54));
+  test::TempDir dir("shm-echo");
+  const std::string out = dir.file("out"), err = dir.file("err");
+  EXPECT_EQ(test::runCommand(echoCommand(name, "> " + out + " 2> " + err)), 1);
+  const std::string errors = test::readFile(err);
+  EXPECT_NE(errors.find("inconsistent segment"), std::string::npos) << errors;
+  EXPECT_LE(lineCount(errors), 2) << errors.substr(0, 2000);
+  EXPECT_LE(lineCount(test::readFile(out)), 8);
+  ::shm_unlink(name.c_str());
+}
+
+// Every slot holds a whole record, but not the one `published` says: the old echo printed "missed poses" for
+// ever, each time going back to the same place.
+TEST(ShmEcho, RecordsNotMatchingTheirSlotsAreSkippedWithoutALineEach) {
+  const std::string name = test::uniqueShmName("echo-mismatch");
+  ASSERT_TRUE(test::makeSegment(name, ::getpid(), 1000, 8));
+  uint8_t bytes[pose::kPacketSize];
+  pose::encodePacket(recordFor(1), bytes);
+  ASSERT_TRUE(test::editSegment(name, [&](pose::ShmHeader&, pose::ShmSlot* slots, uint32_t capacity) {
+    for (uint32_t i = 0; i <= capacity; ++i) pose::seqlockWrite(slots[i], bytes);  // latest slot and ring
+  }));
+  ASSERT_TRUE(test::editSegment(name, [](pose::ShmHeader& h, pose::ShmSlot*, uint32_t) {
+    h.state.store(pose::kWriterStopped);  // so that it ends once past `published`
+  }));
+  test::TempDir dir("shm-echo");
+  const std::string out = dir.file("out"), err = dir.file("err");
+  EXPECT_EQ(test::runCommand(echoCommand(name, "> " + out + " 2> " + err)), 0);
+  const std::string errors = test::readFile(err);
+  EXPECT_LE(lineCount(errors), 1) << errors.substr(0, 2000);
+  EXPECT_EQ(lineCount(test::readFile(out)), 0);
+  ::shm_unlink(name.c_str());
+}
+
+TEST(ShmEcho, ATruncatedSegmentDoesNotKillIt) {
+  const std::string name = test::uniqueShmName("echo-trunc");
+  platform::PoseShmWriter writer(name, 8, 0644);
+  for (uint64_t s = 1; s <= 3; ++s) writer.publish(recordFor(s));
+  test::TempDir dir("shm-echo");
+  test::ChildProcess echo({test::binPath("mcslam-shm-echo"), "--name", name, "--wait", "0.2"}, dir.file("out"),
+                          dir.file("err"));
+  ASSERT_TRUE(test::eventually([&] { return lineCount(test::readFile(dir.file("out"))) == 3; }));
+  ASSERT_TRUE(test::truncateSegment(name));
+  ASSERT_TRUE(echo.endsWithin(60));
+  const std::string err = test::readFile(dir.file("err"));
+  EXPECT_EQ(echo.wait(), 1) << err;  // not 128 + SIGBUS
+  EXPECT_NE(err.find("truncated"), std::string::npos) << err;
+}
+
+TEST(ShmEcho, FollowsASegmentReplacedUnderIt) {
+  const std::string name = test::uniqueShmName("echo-replaced");
+  platform::PoseShmWriter first(name, 8, 0644);
+  for (uint64_t s = 1; s <= 3; ++s) first.publish(recordFor(s));
+  test::TempDir dir("shm-echo");
+  test::ChildProcess echo({test::binPath("mcslam-shm-echo"), "--name", name, "--count", "5"}, dir.file("out"),
+                          dir.file("err"));
+  ASSERT_TRUE(test::eventually([&] { return lineCount(test::readFile(dir.file("out"))) == 3; }));
+  platform::PoseShmWriter second(name, 8, 0644);  // what a restarted daemon does
+  for (uint64_t s = 1; s <= 2; ++s) second.publish(recordFor(s));
+  ASSERT_TRUE(echo.endsWithin(60)) << test::readFile(dir.file("err"));
+  const std::string err = test::readFile(dir.file("err"));
+  EXPECT_EQ(echo.wait(), 0) << err;
+  EXPECT_EQ(sequencesIn(test::readFile(dir.file("out"))), (std::vector<uint64_t>{1, 2, 3, 1, 2})) << err;
+  EXPECT_NE(err.find("reattached"), std::string::npos) << err;
+}
