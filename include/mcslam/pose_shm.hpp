@@ -22,6 +22,8 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -56,7 +58,8 @@ struct alignas(64) ShmHeader {
   int64_t writer_pid;
   int64_t start_time_ns;            // CLOCK_REALTIME when the writer created the segment
   std::atomic<uint64_t> published;  // sequence of the newest pose (0 = none yet)
-  uint64_t reserved[9];
+  uint64_t writer_start_ticks;      // the writer's start, /proc/<pid>/stat field 22 (0 = not recorded)
+  uint64_t reserved[8];
 };
 
 static_assert(sizeof(ShmSlot) == kShmSlotSize);
@@ -98,6 +101,39 @@ inline void seqlockWrite(ShmSlot& slot, const uint8_t in[kPacketSize]) {
 }
 
 enum class ReadStatus { Ok, NotYet, Overwritten, Busy };
+
+// When process `pid` started, in clock ticks after boot (/proc/<pid>/stat, field 22); 0 when it cannot be read.
+// Unlike the pid, which the kernel hands out again, it tells a process from a later one of the same pid. No
+// allocation.
+inline uint64_t processStartTicks(long pid) {
+  char path[48];
+  std::snprintf(path, sizeof(path), "/proc/%ld/stat", pid);
+  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return 0;
+  char text[1024];
+  const ssize_t n = ::read(fd, text, sizeof(text) - 1);
+  ::close(fd);
+  if (n <= 0) return 0;
+  text[n] = '\0';
+  const char* p = std::strrchr(text, ')');  // the end of the command name, which may hold spaces
+  if (!p) return 0;
+  for (int field = 2; field < 22; ++p) {  // a space before each field after the name (field 2)
+    if (*p == '\0') return 0;
+    if (*p == ' ') ++field;
+  }
+  return std::strtoull(p, nullptr, 10);
+}
+
+// Whether the writer of a header with this pid and start still runs: the pid exists and, when the writer recorded
+// its start, belongs to that same process, not to a later one that got the pid after a crash. Where /proc does not
+// show the process (another pid namespace), the pid alone decides.
+inline bool writerProcessRuns(int64_t pid, uint64_t start_ticks) {
+  if (pid <= 0 || pid != static_cast<pid_t>(pid)) return false;
+  if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) return false;
+  if (start_ticks == 0) return true;
+  const uint64_t now = processStartTicks(static_cast<long>(pid));
+  return now == 0 || now == start_ticks;
+}
 
 // What check() found (docs/pose-protocol.md, "staying attached").
 enum class SegmentStatus {
@@ -183,8 +219,7 @@ class PoseShmReader {
       ::close(fd);
       if (!same) return SegmentStatus::Replaced;
     }
-    const pid_t pid = static_cast<pid_t>(writerPid());
-    if (pid <= 0 || (::kill(pid, 0) != 0 && errno == ESRCH)) return SegmentStatus::WriterGone;
+    if (!writerProcessRuns(writerPid(), header().writer_start_ticks)) return SegmentStatus::WriterGone;
     return SegmentStatus::Live;
   }
 

@@ -253,9 +253,12 @@ int runDaemon(const DaemonConfig& config) {
   const DaemonStats s = daemon.stats();
   spdlog::info(
       "stopped: {} frames processed, {} poses published, {} in the trajectory ({}), {} rig frames dropped, "
-      "{} camera images dropped, {} partial, {} bad, {} allocations in {} frames after warm-up (process total {})",
+      "{} camera images dropped, {} partial, {} bad, trigger-to-pose latency p50 {:.1f} ms p99 {:.1f} ms, {} "
+      "allocations in {} frames after warm-up (process total {})",
       s.processed, s.published, s.trajectory_poses, daemon.trajectoryPath(), s.rig_drops, s.camera_drops,
-      s.partial_frames, s.bad_frames, s.allocations_after_warmup, s.frames_after_warmup, alloc::totalCount());
+      s.partial_frames, s.bad_frames, static_cast<double>(s.latency_p50_ns) * 1e-6,
+      static_cast<double>(s.latency_p99_ns) * 1e-6, s.allocations_after_warmup, s.frames_after_warmup,
+      alloc::totalCount());
   if (!clean) spdlog::error("the pipeline did not finish its frame within the grace period");
   if (s.trajectory_errors > 0)
     spdlog::error("trajectory {}: {} poses or syncs failed (last: {}); the file holds whole lines only",

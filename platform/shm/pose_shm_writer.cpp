@@ -23,11 +23,6 @@ int64_t realtimeNs() {
   return static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
-bool processExists(int64_t pid) {
-  if (pid <= 0 || pid != static_cast<pid_t>(pid)) return false;
-  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
-}
-
 // The pid of a running writer that holds `name`, or 0. Read with pread, not mapped: a truncated segment
 // then cannot raise SIGBUS here. Our own pid counts as not running: it is a previous incarnation whose pid
 // we inherited (pid 1 in a restarted container).
@@ -40,11 +35,13 @@ int64_t liveWriterOf(const std::string& name) {
   if (n != static_cast<ssize_t>(sizeof(bytes))) return 0;
   uint32_t magic = 0, state = 0;
   int64_t pid = 0;
+  uint64_t start_ticks = 0;
   std::memcpy(&magic, bytes + offsetof(pose::ShmHeader, magic), sizeof(magic));
   std::memcpy(&state, bytes + offsetof(pose::ShmHeader, state), sizeof(state));
   std::memcpy(&pid, bytes + offsetof(pose::ShmHeader, writer_pid), sizeof(pid));
+  std::memcpy(&start_ticks, bytes + offsetof(pose::ShmHeader, writer_start_ticks), sizeof(start_ticks));
   const bool running = magic == pose::kShmMagic && state == pose::kWriterRunning;
-  return running && pid != ::getpid() && processExists(pid) ? pid : 0;
+  return running && pid != ::getpid() && pose::writerProcessRuns(pid, start_ticks) ? pid : 0;
 }
 
 // glibc keeps POSIX shared memory in /dev/shm.
@@ -127,6 +124,7 @@ void PoseShmWriter::initHeader() {
   h.ring_capacity = capacity_;
   h.ring_offset = pose::kShmHeaderSize + pose::kShmSlotSize;
   h.writer_pid = ::getpid();
+  h.writer_start_ticks = pose::processStartTicks(static_cast<long>(::getpid()));
   h.start_time_ns = realtimeNs();
   h.state.store(pose::kWriterRunning, std::memory_order_relaxed);
   h.published.store(0, std::memory_order_relaxed);

@@ -113,6 +113,30 @@ TEST(PoseShmRobust, ASegmentADeadWriterLeftIsTakenOver) {
   EXPECT_EQ(reader.check(), SegmentStatus::Live);
 }
 
+// A crashed writer's pid given to a later process: the start time the writer recorded tells them apart, so the
+// name is taken over instead of being refused for as long as that process lives.
+TEST(PoseShmRobust, APidReusedAfterACrashDoesNotHoldTheName) {
+  const std::string name = test::uniqueShmName("reused");
+  const pid_t other = ::getppid();  // alive, and not us
+  const uint64_t its_start = pose::processStartTicks(other);
+  ASSERT_GT(its_start, 0u) << "/proc/" << other << "/stat unreadable";
+  EXPECT_TRUE(pose::writerProcessRuns(other, its_start));
+  EXPECT_FALSE(pose::writerProcessRuns(other, its_start + 1));
+  ASSERT_TRUE(test::makeSegment(name, other, 3));
+  ASSERT_TRUE(test::editSegment(name, [&](pose::ShmHeader& h, pose::ShmSlot*, uint32_t) {
+    h.writer_start_ticks = its_start + 1;  // the writer that made it started at another time
+  }));
+  pose::PoseShmReader old_reader;
+  ASSERT_TRUE(old_reader.open(name));
+  EXPECT_EQ(old_reader.check(), SegmentStatus::WriterGone);
+  platform::PoseShmWriter writer(name, 4, 0644);
+  EXPECT_EQ(old_reader.check(), SegmentStatus::Replaced);
+  pose::PoseShmReader reader;
+  ASSERT_TRUE(reader.open(name));
+  EXPECT_EQ(reader.header().writer_start_ticks, pose::processStartTicks(::getpid()));
+  EXPECT_EQ(reader.check(), SegmentStatus::Live);
+}
+
 // Before, A's stop unlinked whatever had the name, here B's live segment.
 TEST(PoseShmRobust, AStopUnlinksOnlyItsOwnSegment) {
   const std::string name = test::uniqueShmName("own");
