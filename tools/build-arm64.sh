@@ -8,6 +8,7 @@
 #                       mmdebstrap (extract variant: the packages unpacked, no foreign code run), remade when the
 #                       package list below changes
 #   MCSLAM_CMAKE_ARGS   extra CMake arguments (e.g. -DMCSLAM_WERROR=ON)
+#   MCSLAM_ARM64_BUILD_DIR  the build folder (default build-arm64; tools/package.sh uses its own)
 # Why a root and not multiarch (dpkg --add-architecture arm64): libopencv-dev, libyaml-cpp-dev and OpenCV's and
 # Ceres' dependencies are not Multi-Arch: same, so their arm64 -dev packages cannot be installed beside the amd64
 # ones tools/setup.sh installs (docs/arm64.md).
@@ -66,9 +67,10 @@ launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 targets=()
 for t in "$@"; do targets+=(--target "$t"); done
+build="${MCSLAM_ARM64_BUILD_DIR:-build-arm64}"
 # shellcheck disable=SC2086
-cmake -S . -B build-arm64 -DCMAKE_BUILD_TYPE=Release -DCMAKE_TOOLCHAIN_FILE="$PWD/cmake/aarch64-linux-gnu.cmake" \
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_TOOLCHAIN_FILE="$PWD/cmake/aarch64-linux-gnu.cmake" \
   -DMCSLAM_ARM64_ROOT="$root" "${launcher[@]}" ${MCSLAM_CMAKE_ARGS:-}
-cmake --build build-arm64 -j"$(nproc)" "${targets[@]}"
-echo "build-arm64: built in build-arm64/ (run the tests with tools/test-arm64.sh)"
-if [ -e build-arm64/bin/mcslamd ]; then file build-arm64/bin/mcslamd; fi
+cmake --build "$build" -j"$(nproc)" "${targets[@]}"
+echo "build-arm64: built in $build/ (run the tests with tools/test-arm64.sh)"
+if [ -e "$build/bin/mcslamd" ]; then file "$build/bin/mcslamd"; fi

@@ -1,12 +1,19 @@
-// Encodes a pose record, decodes it again and checks the round trip; then tries to open a shared-memory segment
-// that does not exist and expects the reader's error. Exit 0 when both behave.
+// A pose consumer built against an installed mcslam. Without arguments: encodes a pose record, decodes it again and
+// checks the round trip, then tries to open a shared-memory segment that does not exist and expects the reader's
+// error (exit 0 when both behave). With a segment name: reads COUNT poses (default 10) from a running mcslamd's
+// segment, waiting up to 120 s for them, and prints the last (exit 0 when they came).
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
+#include <thread>
 
 #include "mcslam/pose_protocol.hpp"
 #include "mcslam/pose_shm.hpp"
 
-int main() {
+namespace {
+
+int selfCheck() {
   mcslam::pose::PoseRecord in;
   in.sequence = 7;
   in.frame_sequence = 42;
@@ -28,4 +35,34 @@ int main() {
   }
   std::printf("consumer: ok (%s)\n", error.c_str());
   return 0;
+}
+
+int readLive(const std::string& segment, uint64_t count) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  mcslam::pose::PoseShmReader reader;
+  std::string error;
+  while (!reader.open(segment, &error) || reader.published() < count) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      std::printf("consumer: %s: fewer than %llu poses in 120 s (%s)\n", segment.c_str(),
+                  static_cast<unsigned long long>(count), error.c_str());
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  mcslam::pose::PoseRecord r;
+  if (reader.readLatest(r) != mcslam::pose::ReadStatus::Ok) {
+    std::puts("consumer: the latest pose could not be read");
+    return 1;
+  }
+  std::printf("consumer: ok, %llu poses, latest frame %llu at (%.3f, %.3f, %.3f), %s\n",
+              static_cast<unsigned long long>(reader.published()), static_cast<unsigned long long>(r.frame_sequence),
+              r.position[0], r.position[1], r.position[2], mcslam::pose::trackingName(r.tracking));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) return selfCheck();
+  return readLive(argv[1], argc > 2 ? std::strtoull(argv[2], nullptr, 10) : 10);
 }

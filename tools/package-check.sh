@@ -1,0 +1,111 @@
+#!/usr/bin/env bash
+# Checks the Debian package the way a robot builder meets it, in a clean Debian 12 root (made once with mmdebstrap,
+# kept in ~/.cache/mcslam/; unpacked afresh for every check): install with apt (its dependencies from Debian), the
+# files and the system user in place, mcslamd started as systemd starts it (the unit's ExecStart, as the unit's
+# user, with $STATE_DIRECTORY; systemd itself cannot run in a chroot) with the packaged configuration (a simulated
+# rig) becomes ready and publishes poses over shared memory and UDP, a consumer built with find_package(mcslam)
+# against the installed headers reads them, SIGTERM stops it cleanly; an upgrade keeps a changed configuration and
+# the state; remove keeps both, purge removes them. Also the unit's `systemd-analyze security` exposure.
+# Needs root (chroot, mounts). amd64 only (an arm64 root would run under qemu-user through binfmt_misc).
+#
+# Usage: tools/package-check.sh [DEB]      (default: the newest dist/mcslam_*_amd64.deb; tools/package.sh makes it)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[ "$(id -u)" -eq 0 ] || { echo "package-check: needs root (chroot and mounts)" >&2; exit 2; }
+deb="${1:-$(ls -t dist/mcslam_*_amd64.deb 2>/dev/null | head -n 1)}"
+[ -f "$deb" ] || { echo "package-check: no package (run tools/package.sh first)" >&2; exit 2; }
+deb="$(realpath "$deb")"
+
+source tools/install-packages.sh
+install_missing package-check mmdebstrap systemd
+cache="${HOME}/.cache/mcslam"
+clean="$cache/debian12-amd64-apt.tar"
+if [ ! -f "$clean" ]; then
+  mkdir -p "$cache"
+  mmdebstrap --variant=apt bookworm "$clean.tmp" "deb http://deb.debian.org/debian bookworm main" \
+    "deb http://deb.debian.org/debian-security bookworm-security main"
+  mv "$clean.tmp" "$clean"
+fi
+root="$(mktemp -d /tmp/mcslam-package-check.XXXXXX)"
+trap 'umount -R "$root/proc" "$root/dev" 2>/dev/null || true; rm -rf "$root"' EXIT
+tar -C "$root" -xf "$clean"
+cp /etc/resolv.conf "$root/etc/resolv.conf"
+mount -t proc proc "$root/proc"
+mount --rbind /dev "$root/dev"
+in_root() { chroot "$root" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEND=noninteractive "$@"; }
+step() { echo "package-check: $*"; }
+fail() { echo "package-check: FAILED: $*" >&2; exit 1; }
+
+step "install $(basename "$deb")"
+cp "$deb" "$root/tmp/mcslam.deb"
+in_root apt-get update -q >/dev/null
+in_root apt-get install -y -q --no-install-recommends /tmp/mcslam.deb >/dev/null
+for f in /usr/bin/mcslamd /usr/bin/mcslam-run /usr/bin/mcslam-shm-echo /usr/bin/mcslam-udp-echo \
+  /usr/lib/*/mcslam/mcslam_image_codec.so /usr/lib/systemd/system/mcslamd.service /etc/mcslamd/mcslamd.yaml \
+  /usr/include/mcslam/pose_shm.hpp /usr/lib/*/cmake/mcslam/mcslamConfig.cmake \
+  /usr/share/mcslam/places/orb_vocabulary.mcvoc /usr/share/doc/mcslam/daemon.md; do
+  compgen -G "$root$f" >/dev/null || fail "$f is not installed"
+done
+in_root getent passwd mcslamd >/dev/null || fail "no system user mcslamd"
+exec_start="$(sed -n 's/^ExecStart=//p' "$root/usr/lib/systemd/system/mcslamd.service")"
+step "the unit runs: $exec_start"
+
+run_daemon() {  # starts the unit's command in the background as systemd would; sets daemon_pid
+  mkdir -p "$root/var/lib/mcslamd"
+  in_root chown mcslamd:mcslamd /var/lib/mcslamd
+  chroot "$root" setpriv --reuid=mcslamd --regid=mcslamd --init-groups \
+    env -i PATH=/usr/bin:/bin STATE_DIRECTORY=/var/lib/mcslamd CONFIGURATION_DIRECTORY=/etc/mcslamd \
+    $exec_start >"$root/tmp/mcslamd.log" 2>&1 &
+  daemon_pid=$!
+}
+stop_daemon() {
+  kill -TERM "$daemon_pid"
+  local status=0
+  wait "$daemon_pid" || status=$?
+  [ "$status" -eq 0 ] || { cat "$root/tmp/mcslamd.log"; fail "mcslamd exited with $status after SIGTERM"; }
+}
+
+run_daemon
+step "poses over UDP (127.0.0.1:9870, the packaged configuration's destination)"
+in_root timeout 180 mcslam-udp-echo --count 5 >"$root/tmp/udp.txt" || { cat "$root/tmp/mcslamd.log"; fail "no UDP poses"; }
+tail -n 1 "$root/tmp/udp.txt"
+step "poses over shared memory (/mcslam_pose)"
+in_root timeout 60 mcslam-shm-echo --count 5 --wait 30 >"$root/tmp/shm.txt" || fail "no poses in shared memory"
+tail -n 1 "$root/tmp/shm.txt"
+
+step "a C++ consumer built with find_package(mcslam) against the installed package"
+in_root apt-get install -y -q --no-install-recommends cmake g++ make >/dev/null
+mkdir -p "$root/tmp/consumer"
+cp tests/install/consumer/CMakeLists.txt tests/install/consumer/consumer.cpp "$root/tmp/consumer/"
+in_root cmake -S /tmp/consumer -B /tmp/consumer/build >/dev/null
+in_root cmake --build /tmp/consumer/build >/dev/null
+in_root /tmp/consumer/build/consumer /mcslam_pose 10 || fail "the consumer read no poses"
+stop_daemon
+grep -q "stopped:" "$root/tmp/mcslamd.log" || fail "no stop summary in the log"
+[ -s "$root/var/lib/mcslamd/trajectory.tum" ] || fail "no trajectory in the state directory"
+step "stopped cleanly; trajectory $(grep -vc '^#' "$root/var/lib/mcslamd/trajectory.tum") poses in /var/lib/mcslamd"
+
+step "upgrade keeps a changed configuration and the state"
+echo "# changed by the robot builder" >>"$root/etc/mcslamd/mcslamd.yaml"
+echo "saved map stand-in" >"$root/var/lib/mcslamd/map.mcmap"
+next="$root/tmp/next"
+dpkg-deb -R "$deb" "$next"
+version="$(sed -n 's/^Version: //p' "$next/DEBIAN/control")"
+sed -i "s/^Version: .*/Version: ${version}+check1/" "$next/DEBIAN/control"
+dpkg-deb -b "$next" "$root/tmp/mcslam-next.deb" >/dev/null
+in_root apt-get install -y -q /tmp/mcslam-next.deb >/dev/null
+[ "$(in_root dpkg-query -W -f='${Version}' mcslam)" = "${version}+check1" ] || fail "the upgrade did not install"
+grep -q "changed by the robot builder" "$root/etc/mcslamd/mcslamd.yaml" || fail "the upgrade replaced the configuration"
+[ -f "$root/var/lib/mcslamd/map.mcmap" ] || fail "the upgrade lost the state"
+
+step "remove keeps the configuration and the state; purge removes them"
+in_root apt-get remove -y -q mcslam >/dev/null
+[ ! -e "$root/usr/bin/mcslamd" ] || fail "remove left /usr/bin/mcslamd"
+[ -f "$root/etc/mcslamd/mcslamd.yaml" ] && [ -f "$root/var/lib/mcslamd/map.mcmap" ] || fail "remove lost the configuration or the state"
+in_root apt-get purge -y -q mcslam >/dev/null
+[ ! -e "$root/etc/mcslamd/mcslamd.yaml" ] && [ ! -e "$root/var/lib/mcslamd" ] || fail "purge left the configuration or the state"
+
+step "the unit's sandboxing (systemd-analyze security, offline)"
+dpkg-deb -x "$deb" "$root/unpacked"
+systemd-analyze security --offline=true "$root/unpacked/usr/lib/systemd/system/mcslamd.service" 2>/dev/null | tail -n 1
+echo "package-check: all checks passed"
