@@ -125,3 +125,17 @@ TEST_F(RunLayouts, TheRunnerSaysWhenTheTrajectoryIsNotMetric) {
   EXPECT_EQ(pair.find("unit is arbitrary"), std::string::npos) << pair;
   EXPECT_EQ(jsonInt(test::readFile(dir_->file("unit.json")), "frames_unknown_scale"), 0);
 }
+
+// A run that gives no frame a pose (one camera cannot initialize from one frame) fails and says why, instead of
+// exiting 0 with an empty trajectory.
+TEST_F(RunLayouts, ARunThatGivesNoPoseAtAllFailsAndSaysWhy) {
+  std::string out;
+  const std::string trajectory = dir_->file("none.tum");
+  EXPECT_EQ(
+      test::runCommand(
+          bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --cameras 0 --frames 1 --out " + trajectory, &out),
+      1)
+      << out;
+  EXPECT_NE(out.find("no frame of 1 got a pose"), std::string::npos) << out;
+  EXPECT_EQ(test::readFile(trajectory).rfind("# ", 0), 0u) << "the (empty) trajectory is still written";
+}

@@ -72,7 +72,9 @@ void addOptions(CLI::App& app, RunOptions& o) {
                  "Calibration to use instead of the dataset's own (Kalibr YAML, EuRoC sensor.yaml, KITTI calib.txt)");
   app.add_option("--cameras", o.cameras_text,
                  "Cameras of the rig to use, by calibration index, e.g. 0,1,2 (default: all)");
-  app.add_option("--out", o.out_path, "Trajectory of every frame, TUM format (pose of the body in the world)");
+  app.add_option("--out", o.out_path,
+                 "Trajectory, TUM format (pose of the body in the world): every frame that has a pose (none before "
+                 "the map is initialized, while lost, or while localizing in a loaded map); --stats counts them");
   app.add_option("--keyframes", o.keyframes_path, "Keyframe poses, TUM format");
   app.add_option("--stats", o.stats_path, "Timing per stage (mean, p99) and tracking states, JSON");
   app.add_option("--extrinsics", o.extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
@@ -330,6 +332,13 @@ int runDataset(const RunOptions& o) {
   if (!o.extrinsics_path.empty()) writeKalibrRig(pipeline.refinedRig(), o.extrinsics_path);
   if (!o.map_out.empty()) saveMap(pipeline, o.map_out);
   if (!o.quiet) printSummary(pipeline, report, wall);
+  if (report.trajectory().empty()) {
+    std::fprintf(stderr,
+                 "mcslam-run: error: no frame of %zu got a pose (the map never initialized, or the run never "
+                 "recognized where it is in the loaded map); the trajectory is empty\n",
+                 order.size());
+    return 1;
+  }
   return 0;
 }
 
