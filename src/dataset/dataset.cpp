@@ -57,7 +57,13 @@ class DatasetBuilder {
       ds.ground_truth_ = layout->readGroundTruthFile(options.ground_truth_path, full);
       ds.ground_truth_path_ = options.ground_truth_path;
     } else {
-      ds.ground_truth_ = layout->loadGroundTruth(full, ds.warnings_, &ds.ground_truth_path_);
+      try {
+        ds.ground_truth_ = layout->loadGroundTruth(full, ds.warnings_, &ds.ground_truth_path_);
+      } catch (const InputError& e) {
+        ds.ground_truth_problem_ = e.what();
+        ds.ground_truth_path_.clear();
+        ds.warnings_.push_back(std::string("ground truth ignored: ") + e.what());
+      }
     }
     return ds;
   }
@@ -135,6 +141,12 @@ Rig loadRigFromPath(const std::string& path) {
   // EuRoC sensor.yaml has a top-level T_BS; Kalibr files have cam0, cam1, ...
   const bool euroc = text.rfind("T_BS:", 0) == 0 || text.find("\nT_BS:") != std::string::npos;
   return euroc ? loadEurocSensorRig({path}) : loadKalibrRig(path);
+}
+
+const Trajectory& Dataset::requireGroundTruth() const {
+  if (ground_truth_) return *ground_truth_;
+  if (!ground_truth_problem_.empty()) throw InputError(ground_truth_problem_);
+  throw InputError(dir_ + ": the dataset has no ground truth");
 }
 
 }  // namespace mcslam

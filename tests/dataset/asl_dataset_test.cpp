@@ -188,6 +188,32 @@ TEST(AslDataset, GroundTruthOverrideAndNoGroundTruth) {
   EXPECT_EQ(ds.groundTruthPath(), dir.file("gt.txt"));
 }
 
+// A dataset's own ground truth that cannot be read does not stop what needs only the images: it is left out with a
+// warning, and what needs it gets the file's error.
+TEST(AslDataset, AnUnreadableGroundTruthIsLeftOutWithAWarningAndItsReasonKept) {
+  test::TempDir dir("asl");
+  const std::string root = writeDataset(dir);
+  test::writeFile(root + "/groundtruth.txt", "garbage line here\n");
+  const Dataset ds = Dataset::open(root);
+  EXPECT_GT(ds.size(), 0u);
+  EXPECT_FALSE(ds.groundTruth().has_value());
+  ASSERT_FALSE(ds.warnings().empty());
+  EXPECT_NE(ds.warnings().back().find("groundtruth.txt"), std::string::npos) << ds.warnings().back();
+  try {
+    ds.requireGroundTruth();
+    FAIL() << "no ground truth, no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("groundtruth.txt: line 1"), std::string::npos) << e.what();
+  }
+  fs::remove(root + "/groundtruth.txt");
+  try {
+    Dataset::open(root).requireGroundTruth();
+    FAIL() << "no ground truth, no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no ground truth"), std::string::npos) << e.what();
+  }
+}
+
 TEST(AslDataset, NotADatasetIsAClearError) {
   test::TempDir dir("asl");
   for (const std::string& path : {dir.file("nothing"), dir.path().string()}) {

@@ -56,8 +56,7 @@ void addCommon(CLI::App* cmd, CommonArgs& a) {
 Trajectory load(const std::string& path, const std::string& format, const std::string& times) {
   if (std::filesystem::is_directory(path)) {
     const Dataset ds = Dataset::open(path);
-    if (!ds.groundTruth()) throw InputError(path + ": the dataset has no ground truth");
-    return *ds.groundTruth();
+    return ds.requireGroundTruth();
   }
   if (format == "kitti") return readKittiTrajectory(path, times);
   if (!times.empty()) throw InputError(times + ": a times file only goes with --format kitti");

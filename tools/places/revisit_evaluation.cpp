@@ -40,8 +40,7 @@ RevisitResult evaluateRevisits(const std::string& dataset_dir, const Vocabulary&
   DatasetOptions dataset_options;
   dataset_options.cameras = o.cameras;
   const Dataset dataset = Dataset::open(dataset_dir, dataset_options);
-  if (!dataset.groundTruth()) throw InputError(dataset_dir + ": the dataset has no ground truth to tell revisits");
-  const Trajectory& gt = *dataset.groundTruth();
+  const Trajectory& gt = dataset.requireGroundTruth();
   const int cameras = dataset.rig().size();
   int max_width = 0, max_height = 0;
   for (int c = 0; c < cameras; ++c) {

@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
     DatasetOptions options;
     if (!cameras.empty()) options.cameras = parseCameraList(cameras);
     const Dataset ds = Dataset::open(dataset_dir, options);
-    if (!ds.groundTruth()) throw InputError(dataset_dir + ": no ground truth to compare with");
+    ds.requireGroundTruth();  // the pairs are compared with it
     const PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", ds.rig());
     FeatureSource source(ds, config);
     FrameFeatures ref(ds.rig().size(), source.capacity()), cur(ds.rig().size(), source.capacity());

@@ -56,6 +56,10 @@ class Dataset {
   const std::optional<Trajectory>& groundTruth() const { return ground_truth_; }
   // The file the ground truth came from (empty without ground truth).
   const std::string& groundTruthPath() const { return ground_truth_path_; }
+  // The ground truth, or InputError naming the dataset and why it has none: no file, or what was wrong with the
+  // dataset's own file, kept from open() (a run that does not need the ground truth is not stopped by a bad one;
+  // it gets a warning).
+  const Trajectory& requireGroundTruth() const;
   // The tolerance used to assemble rig frames (the option, or the automatic choice).
   Timestamp syncToleranceNs() const { return sync_tolerance_ns_; }
   // Problems met while indexing (e.g. a camera listing a missing file); the frames stay usable.
@@ -73,6 +77,7 @@ class Dataset {
   std::vector<RigFrameEntry> frames_;
   std::optional<Trajectory> ground_truth_;
   std::string ground_truth_path_;
+  std::string ground_truth_problem_;
   Timestamp sync_tolerance_ns_ = 0;
   std::vector<std::string> warnings_;
   friend class DatasetBuilder;
