@@ -7,6 +7,7 @@
 #include "daemon/config_names.hpp"
 #include "daemon/yaml_fields.hpp"
 #include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/config_section.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/dataset/dataset.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
@@ -249,13 +250,7 @@ Rig resolveRig(const DaemonConfig& c, const YamlFields& top) {
   return aravisRig(c, top);
 }
 
-YAML::Node loadYaml(const std::string& yaml_text, const std::string& file) {
-  try {
-    return YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(file + ": not valid YAML: " + e.what());
-  }
-}
+YAML::Node loadYaml(const std::string& yaml_text, const std::string& file) { return parseYamlText(yaml_text, file); }
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include <map>
 #include <sstream>
 
+#include "mcslam/core/config_section.hpp"
 #include "mcslam/core/error.hpp"
 
 namespace mcslam {
@@ -129,6 +130,11 @@ CameraModel readCameraModel(const YAML::Node& cam, const Where& w, const std::st
       const std::vector<double> c = readNumbers(cam, w, coeffs_field, 4);
       std::copy(c.begin(), c.end(), k.begin());
     }
+  } else if (cam[coeffs_field]) {
+    // Coefficients without a model would be dropped: the lens would be taken for a distortion-free one.
+    const std::vector<double> c = readNumbers(cam, w, coeffs_field, 4);
+    if (std::any_of(c.begin(), c.end(), [](double v) { return v != 0; }))
+      w.fail(coeffs_field, "is given without distortion_model (radtan or equidistant): say which model they are for");
   }
   return CameraModel(static_cast<int>(res[0]), static_cast<int>(res[1]), in[0], in[1], in[2], in[3], dist, k);
 }
@@ -143,11 +149,7 @@ std::string stripOpenCvHeader(const std::string& text) {
 }
 
 YAML::Node parseYaml(const std::string& text, const std::string& source) {
-  try {
-    return YAML::Load(stripOpenCvHeader(text));
-  } catch (const YAML::Exception& e) {
-    throw InputError(source + ": not valid YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  return parseYamlText(stripOpenCvHeader(text), source);
 }
 
 void applyBody(Rig& rig, const RigLoadOptions& options) {

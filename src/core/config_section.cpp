@@ -8,6 +8,42 @@
 
 namespace mcslam {
 
+namespace {
+
+void rejectDuplicateKeys(const YAML::Node& node, const std::string& path, const std::string& source) {
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i)
+      rejectDuplicateKeys(node[i], path + "[" + std::to_string(i) + "]", source);
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::vector<std::pair<std::string, int>> seen;  // key, line
+  for (const auto& entry : node) {
+    const std::string key = entry.first.Scalar();
+    const int line = entry.first.Mark().line + 1;
+    const std::string key_path = path.empty() ? key : path + "." + key;
+    for (const auto& [other, other_line] : seen)
+      if (other == key)
+        throw InputError(source + ": line " + std::to_string(line) + ": " + key_path + ": appears twice in one map " +
+                         "(first at line " + std::to_string(other_line) + ")");
+    seen.emplace_back(key, line);
+    rejectDuplicateKeys(entry.second, key_path, source);
+  }
+}
+
+}  // namespace
+
+YAML::Node parseYamlText(const std::string& text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ": not valid YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  rejectDuplicateKeys(root, "", source);
+  return root;
+}
+
 ConfigSection::ConfigSection(const YAML::Node& node, std::string path, std::string source)
     : node_(node), path_(std::move(path)), source_(std::move(source)) {
   if (node_ && !node_.IsNull() && !node_.IsMap()) {

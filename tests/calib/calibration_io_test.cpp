@@ -122,6 +122,12 @@ TEST(KalibrRig, BadCalibrationNamesFileCameraAndField) {
   expectRejected(replaced(kTwoCams, "cam1:", "cam2:"), {"rig.yaml", "cam1", "missing"});
   expectRejected("something: 1\n", {"rig.yaml", "no cameras"});
   expectRejected("cam0: [unclosed\n", {"rig.yaml", "YAML"});
+  // Coefficients without a model were dropped: the lens taken for a distortion-free one.
+  expectRejected(replaced(kTwoCams, "  distortion_model: radtan\n", ""),
+                 {"rig.yaml", "cam0", "distortion_coeffs", "without distortion_model"});
+  // A key given twice: the parser kept one silently.
+  expectRejected(replaced(kTwoCams, "camera_model: pinhole", "camera_model: pinhole\n  camera_model: omni"),
+                 {"rig.yaml", "cam0.camera_model", "appears twice", "line"});
   expectRejected(
       replaced(kTwoCams, "    - [1, 0, 0, -0.2]\n    - [0, 1, 0, 0]\n    - [0, 0, 1, 0]\n    - [0, 0, 0, 1]\n", ""),
       {"cam1", "T_cn_cnm1"});

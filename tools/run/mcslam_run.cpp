@@ -14,6 +14,7 @@
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/core/config_section.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/synced_file.hpp"
 #include "mcslam/dataset/dataset.hpp"
@@ -109,12 +110,7 @@ void addOptions(CLI::App& app, RunOptions& o) {
 // The `slam:` section of a config file; a file holding only the section's keys is accepted too.
 YAML::Node slamSection(const std::string& path) {
   if (path.empty()) return YAML::Node();
-  YAML::Node root;
-  try {
-    root = YAML::Load(readTextFile(path));
-  } catch (const YAML::Exception& e) {
-    throw InputError(path + ": not valid YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = parseYamlText(readTextFile(path), path);
   if (root.IsMap() && root["slam"]) return root["slam"];
   return root;
 }

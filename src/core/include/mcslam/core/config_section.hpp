@@ -9,6 +9,11 @@
 
 namespace mcslam {
 
+// Parses a configuration or calibration file's text: InputError naming `source` and the line for YAML that does not
+// parse, and for a key that appears twice in one map (YAML parsers keep one of them silently, and the file would
+// not mean what it seems to say).
+YAML::Node parseYamlText(const std::string& text, const std::string& source);
+
 class ConfigSection {
  public:
   // `path` is the key path of this section ("" for the root), `source` the file name.
