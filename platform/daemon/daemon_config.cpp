@@ -203,6 +203,13 @@ Rig datasetRig(const DaemonConfig& c) {
   DatasetOptions options;
   options.calibration_override = c.calibration;
   options.cameras = c.dataset.cameras;
+  if (!c.calibration.empty()) {  // its own errors name its key, not the dataset's
+    try {
+      loadRigFromPath(c.calibration);
+    } catch (const InputError& e) {
+      throw InputError(c.file + ": calibration: " + e.what());
+    }
+  }
   try {
     return Dataset::open(c.dataset.path, options).rig();
   } catch (const InputError& e) {

@@ -61,6 +61,8 @@ TEST_F(ConfigTest, RelativePathsAreTakenFromTheConfigFilesFolder) {
 TEST_F(ConfigTest, UnknownKeysAreNamedWithTheirPath) {
   expectError(replay("bogus: 1\n"), {"bogus", "unknown key"});
   expectError(replay("status_interval_s: 1\nstatus_interval_s: 2\n"), {"status_interval_s", "appears twice", "line"});
+  // A calibration file that is missing is blamed on its own key, not on the dataset's path.
+  expectError(replay("calibration: no_such_rig.yaml\n"), {"calibration: ", "no_such_rig.yaml"});
   expectError(replay("publish:\n  shm:\n    nam: /x\n"), {"publish.shm.nam", "unknown key"});
   expectError(replay().replace(replay().find("    path"), 0, "    sped: 2\n"), {"source.dataset.sped"});
 }
