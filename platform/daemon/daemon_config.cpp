@@ -308,6 +308,8 @@ SourceContext sourceContext(const DaemonConfig& c) {
   return s;
 }
 
-DaemonConfig loadDaemonConfig(const std::string& path) { return parseDaemonConfig(readTextFile(path), path); }
+DaemonConfig loadDaemonConfig(const std::string& path) {
+  return parseDaemonConfig(readTextFile(path, kMaxConfigFileBytes), path);
+}
 
 }  // namespace mcslam::platform

@@ -158,16 +158,23 @@ void applyBody(Rig& rig, const RigLoadOptions& options) {
 
 }  // namespace
 
-std::string readTextFile(const std::string& path) {
+std::string readTextFile(const std::string& path, std::size_t max_bytes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  std::string text;
+  char chunk[65536];
+  while (in.read(chunk, sizeof(chunk)) || in.gcount() > 0) {
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > max_bytes)
+      throw InputError(path + ": larger than " + std::to_string(max_bytes >> 20) + " MB, more than a file of this " +
+                       "kind holds (is it the right file?)");
+  }
+  if (in.bad()) throw InputError(path + ": read error");
+  return text;
 }
 
 Rig loadKalibrRig(const std::string& path, const RigLoadOptions& options) {
-  return parseKalibrRig(readTextFile(path), path, options);
+  return parseKalibrRig(readTextFile(path, kMaxConfigFileBytes), path, options);
 }
 
 Rig parseKalibrRig(const std::string& yaml_text, const std::string& source, const RigLoadOptions& options) {
@@ -233,7 +240,7 @@ Rig loadEurocSensorRig(const std::vector<std::string>& paths, const RigLoadOptio
   for (std::size_t i = 0; i < paths.size(); ++i) {
     const std::string name = "cam" + std::to_string(i);
     const Where w{paths[i], name};
-    const YAML::Node root = parseYaml(readTextFile(paths[i]), paths[i]);
+    const YAML::Node root = parseYaml(readTextFile(paths[i], kMaxConfigFileBytes), paths[i]);
     if (!root.IsMap()) throw InputError(paths[i] + ": expected an EuRoC sensor.yaml map");
     RigCamera rc;
     rc.name = name;

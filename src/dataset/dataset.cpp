@@ -137,7 +137,7 @@ Rig loadRigFromPath(const std::string& path) {
   if (!fs::exists(p)) throw InputError(path + ": no such file or folder");
   if (fs::is_directory(p)) return detail::detectLayout(path)->loadRig();
   if (p.filename() == "calib.txt") return detail::makeKittiLayout(p.parent_path().string())->loadRig();
-  const std::string text = readTextFile(path);
+  const std::string text = readTextFile(path, kMaxConfigFileBytes);
   // EuRoC sensor.yaml has a top-level T_BS; Kalibr files have cam0, cam1, ...
   const bool euroc = text.rfind("T_BS:", 0) == 0 || text.find("\nT_BS:") != std::string::npos;
   return euroc ? loadEurocSensorRig({path}) : loadKalibrRig(path);

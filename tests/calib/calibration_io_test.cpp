@@ -137,6 +137,13 @@ TEST(KalibrRig, BadCalibrationNamesFileCameraAndField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/rig.yaml"), std::string::npos);
   }
+  // A device that never ends is read only up to what a calibration file could hold, then refused.
+  try {
+    loadKalibrRig("/dev/zero");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: larger than 16 MB"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Rig, SubsetKeepsTheBodyFrame) {

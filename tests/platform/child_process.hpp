@@ -4,7 +4,6 @@
 // assertion leaves nothing running.
 #include <fcntl.h>
 #include <signal.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,17 +12,16 @@
 #include <thread>
 #include <vector>
 
+#include "test_support.hpp"
+
 namespace mcslam::test {
 
 class ChildProcess {
  public:
   // Runs argv[0] (a path) with stdout to `out`, stderr to `err`; as user `uid` (and its group) when given.
   ChildProcess(const std::vector<std::string>& argv, const std::string& out, const std::string& err, int uid = -1) {
-    const pid_t parent = ::getpid();
-    pid_ = ::fork();
+    pid_ = forkDyingWithParent();
     if (pid_ != 0) return;
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (::getppid() != parent) ::_exit(127);
     ::dup2(::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), 1);
     ::dup2(::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), 2);
     ::unsetenv("NOTIFY_SOCKET");

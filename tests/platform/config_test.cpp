@@ -107,6 +107,17 @@ TEST_F(ConfigTest, InconsistentCombinationsAreRefused) {
 
 TEST_F(ConfigTest, MalformedYamlIsReportedWithTheFile) { expectError("source: {type: dataset\n", {"not valid YAML"}); }
 
+// A configuration path that names a device which never ends (/dev/zero) is read only up to what a configuration
+// could hold, then refused: no reading until memory runs out.
+TEST_F(ConfigTest, AnEndlessFileIsRefusedAfterABoundedRead) {
+  try {
+    loadDaemonConfig("/dev/zero");
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: larger than 16 MB"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(ConfigTest, SimSourceGetsThePresetsCamerasAndDefaults) {
   const DaemonConfig c = parseDaemonConfig(
       "source:\n  type: sim\n  sim:\n    rig: isec\n    cameras: [0, 1, 2, 3, 4]\n    world: corridor\n",

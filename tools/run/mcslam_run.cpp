@@ -110,7 +110,7 @@ void addOptions(CLI::App& app, RunOptions& o) {
 // The `slam:` section of a config file; a file holding only the section's keys is accepted too.
 YAML::Node slamSection(const std::string& path) {
   if (path.empty()) return YAML::Node();
-  const YAML::Node root = parseYamlText(readTextFile(path), path);
+  const YAML::Node root = parseYamlText(readTextFile(path, kMaxConfigFileBytes), path);
   if (root.IsMap() && root["slam"]) return root["slam"];
   return root;
 }

@@ -5,6 +5,7 @@
 //    "%YAML:1.0" first line OpenCV writes.
 //  - EuRoC per-camera sensor.yaml (T_BS, intrinsics, distortion_coefficients, resolution).
 // Every error names the file, the camera and the field.
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,7 +30,11 @@ Rig loadEurocSensorRig(const std::vector<std::string>& sensor_yaml_paths, const 
 void writeKalibrRig(const Rig& rig, const std::string& path);
 std::string formatKalibrRig(const Rig& rig);
 
-// Reads a whole text file; throws InputError naming the path when it cannot.
-std::string readTextFile(const std::string& path);
+// Reads a whole text file; throws InputError naming the path when it cannot or when it holds more than
+// `max_bytes` (a device such as /dev/zero, or the wrong file, must not take the memory). The default bounds the data
+// files (image lists, ground truth); configuration and calibration files are far smaller.
+inline constexpr std::size_t kMaxDataFileBytes = std::size_t{1} << 30;
+inline constexpr std::size_t kMaxConfigFileBytes = std::size_t{16} << 20;
+std::string readTextFile(const std::string& path, std::size_t max_bytes = kMaxDataFileBytes);
 
 }  // namespace mcslam
