@@ -18,6 +18,8 @@ package_args="-DCMAKE_INSTALL_PREFIX=/usr -DMCSLAM_PACKAGE=ON -DMCSLAM_DEB_ARCHI
 -DMCSLAM_BUILD_TESTS=OFF -DMCSLAM_BUILD_BENCHMARKS=OFF"
 build="build-package-$arch"
 if [ "$arch" = arm64 ]; then
+  # The multiarch library folder, as the native build's GNUInstallDirs picks on Debian (a cross build does not).
+  package_args="$package_args -DCMAKE_INSTALL_LIBDIR=lib/aarch64-linux-gnu"
   MCSLAM_ARM64_BUILD_DIR="$build" MCSLAM_CMAKE_ARGS="$package_args ${MCSLAM_CMAKE_ARGS:-}" tools/build-arm64.sh
 else
   source tools/install-packages.sh

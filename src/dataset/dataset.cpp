@@ -113,13 +113,14 @@ int Dataset::loadImages(std::size_t i, std::vector<Image>& images, std::vector<b
     const std::string& path = frame.image_paths[c];
     if (path.empty()) continue;
     Image& img = images[c];
+    const CameraModel& m = rig_.model(c);
     try {
-      readGreyImageFile(path, img);  // binary PGM: no allocation once img has the size
+      // Binary PGM: no allocation once img has the size. Nothing larger than the camera is decoded.
+      readGreyImageFile(path, img, ImageBound{m.width(), m.height()});
     } catch (const InputError& e) {
       report(std::string(e.what()) + "; " + rig_.cameras[c].name + " left out");
       continue;
     }
-    const CameraModel& m = rig_.model(c);
     if (img.width() != m.width() || img.height() != m.height()) {
       report(path + ": image is " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +
              " but the calibration of " + rig_.cameras[c].name + " says " + std::to_string(m.width()) + "x" +

@@ -5,7 +5,7 @@
 #include <stdint.h>
 
 // Bumped whenever a signature below changes, so that a stale module is refused instead of called wrongly.
-#define MCSLAM_IMAGE_CODEC_ABI_VERSION 1
+#define MCSLAM_IMAGE_CODEC_ABI_VERSION 2
 
 #define MCSLAM_IMAGE_CODEC_ABI_SYMBOL "mcslam_image_codec_abi_version"
 #define MCSLAM_IMAGE_CODEC_READ_SYMBOL "mcslam_image_codec_read_grey"
@@ -14,8 +14,9 @@
 extern "C" {
 #endif
 
-// Called once the image's size is known: returns where to write `height` rows of `width` bytes, *stride bytes
-// apart, or NULL to refuse (the read then fails).
+// Called once the image's size is known, before decoding where the format's header tells it (PNG, JPEG): returns
+// where to write `height` rows of `width` bytes, *stride bytes apart, or NULL to refuse (the read then fails without
+// decoding).
 typedef uint8_t* (*mcslam_grey_target_fn)(void* context, int width, int height, ptrdiff_t* stride);
 
 typedef int (*mcslam_image_codec_abi_fn)(void);

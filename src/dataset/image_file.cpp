@@ -75,10 +75,15 @@ long pgmField(const uint8_t* head, std::size_t n, std::size_t& pos, const char* 
   return value;
 }
 
+InputError tooLarge(const std::string& path, long width, long height, ImageBound bound) {
+  return InputError(path + ": image is " + std::to_string(width) + "x" + std::to_string(height) + ", larger than the " +
+                    std::to_string(bound.width) + "x" + std::to_string(bound.height) + " this camera has; not decoded");
+}
+
 // Parses the header in head[0, n) (magic already checked), then reads the pixels: those already in `head` and
 // the rest straight from the file into `image`.
 void readPgmPixels(const FileDescriptor& file, const std::string& path, const uint8_t* head, std::size_t n,
-                   Image& image) {
+                   Image& image, ImageBound bound) {
   std::size_t pos = 2;
   const long width = pgmField(head, n, pos, "width", path);
   const long height = pgmField(head, n, pos, "height", path);
@@ -94,6 +99,7 @@ void readPgmPixels(const FileDescriptor& file, const std::string& path, const ui
     throw InputError(path + ": PGM header: maxval " + std::to_string(maxval) +
                      (maxval == kSaturated ? " or more" : "") + " (only 8-bit grey with maxval 255 is read" +
                      (maxval > 255 ? "; this is a 16-bit image)" : ")"));
+  if (!bound.admits(static_cast<int>(width), static_cast<int>(height))) throw tooLarge(path, width, height, bound);
   image.resize(static_cast<int>(width), static_cast<int>(height));
   const std::size_t total = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   const std::size_t buffered = std::min(n - std::min(pos, n), total);
@@ -114,13 +120,27 @@ std::string printableMagic(const uint8_t* head, std::size_t n) {
   return out;
 }
 
+struct DecodeTarget {
+  Image& image;
+  ImageBound bound;
+  bool refused = false;  // larger than the bound
+  int width = 0, height = 0;
+};
+
+// The codec module asks for the buffer once it knows the size, before decoding where the format's header tells.
 uint8_t* growImage(void* context, int width, int height, ptrdiff_t* stride) noexcept {
+  DecodeTarget& target = *static_cast<DecodeTarget*>(context);
   if (width < 1 || height < 1) return nullptr;
+  if (!target.bound.admits(width, height)) {
+    target.refused = true;
+    target.width = width;
+    target.height = height;
+    return nullptr;
+  }
   try {
-    Image& image = *static_cast<Image*>(context);
-    image.resize(width, height);
+    target.image.resize(width, height);
     *stride = width;
-    return image.data();
+    return target.image.data();
   } catch (...) {
     return nullptr;
   }
@@ -128,25 +148,28 @@ uint8_t* growImage(void* context, int width, int height, ptrdiff_t* stride) noex
 
 }  // namespace
 
-void readPgmFile(const std::string& path, Image& image) {
+void readPgmFile(const std::string& path, Image& image, ImageBound bound) {
   const FileDescriptor file(path);
   uint8_t head[kPgmHeaderBytes];
   const std::size_t n = file.read(head, sizeof head, path);
   if (!isBinaryPgm(head, n))
     throw InputError(path + ": not a binary PGM: starts with '" + printableMagic(head, n) + "' (expected 'P5')");
-  readPgmPixels(file, path, head, n, image);
+  readPgmPixels(file, path, head, n, image, bound);
 }
 
-void readGreyImageFile(const std::string& path, Image& image) {
+void readGreyImageFile(const std::string& path, Image& image, ImageBound bound) {
   {
     const FileDescriptor file(path);
     uint8_t head[kPgmHeaderBytes];
     const std::size_t n = file.read(head, sizeof head, path);
-    if (isBinaryPgm(head, n)) return readPgmPixels(file, path, head, n, image);
+    if (isBinaryPgm(head, n)) return readPgmPixels(file, path, head, n, image, bound);
   }
   const mcslam_image_codec_read_fn read = detail::imageCodecReader(path);
   char reason[512] = {};
-  if (read(path.c_str(), growImage, &image, reason, sizeof reason) != 0) throw InputError(path + ": " + reason);
+  DecodeTarget target{image, bound};
+  if (read(path.c_str(), growImage, &target, reason, sizeof reason) == 0) return;
+  if (target.refused) throw tooLarge(path, target.width, target.height, bound);
+  throw InputError(path + ": " + reason);
 }
 
 void writePgmFile(const std::string& path, const ImageView& image) {

@@ -111,10 +111,13 @@ TEST(AslDataset, AnUnreadableImageIsReportedAndItsCameraMarkedAbsent) {
   EXPECT_FALSE(present[0]);
   EXPECT_TRUE(present[1] && present[2]);
   EXPECT_NE(error.find(broken + ": cannot read image"), std::string::npos) << error;
-  // A wrong size is reported too.
+  // A wrong size is reported too: a larger image is not even decoded.
   test::writePng(broken, 7, test::kWidth * 2, test::kHeight);
   EXPECT_EQ(ds.loadImages(4, images, present, &error), 2);
-  EXPECT_NE(error.find("is 32x12 but the calibration of cam0 says 16x12"), std::string::npos) << error;
+  EXPECT_NE(error.find("image is 32x12, larger than the 16x12 this camera has"), std::string::npos) << error;
+  test::writePng(broken, 7, test::kWidth / 2, test::kHeight);
+  EXPECT_EQ(ds.loadImages(4, images, present, &error), 2);
+  EXPECT_NE(error.find("is 8x12 but the calibration of cam0 says 16x12"), std::string::npos) << error;
   // Frames out of range are an error message, not a crash.
   EXPECT_EQ(ds.loadImages(99, images, present, &error), 0);
   EXPECT_NE(error.find("frame 99 does not exist"), std::string::npos) << error;

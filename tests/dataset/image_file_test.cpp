@@ -142,6 +142,45 @@ TEST(ImageCodecModule, PngReadsBackIdenticalThroughTheModuleLoadedOnFirstUse) {
   EXPECT_EQ(module.path, imageCodecModuleCandidates().front());
 }
 
+// The message of the InputError readGreyImageFile throws for `path` read with `bound` ("" when none is thrown).
+std::string boundError(const std::string& path, ImageBound bound, Image& image) {
+  try {
+    readGreyImageFile(path, image, bound);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A small file may claim a huge image (a PNG of 875 KB can say 30000x30000): what is larger than the camera is
+// refused from its header, before any pixel is decoded, for PGM, PNG and JPEG alike.
+TEST(ImageBound, AnImageLargerThanTheCameraIsRefusedBeforeDecoding) {
+  test::TempDir dir("bound");
+  const Image pixels = randomImage(100, 80, 5);
+  const cv::Mat mat(pixels.height(), pixels.width(), CV_8UC1, const_cast<uint8_t*>(pixels.data()));
+  const std::string png = dir.file("a.png"), jpg = dir.file("a.jpg"), pgm = dir.file("a.pgm");
+  ASSERT_TRUE(cv::imwrite(png, mat));
+  ASSERT_TRUE(cv::imwrite(jpg, mat));
+  writePgmFile(pgm, pixels.view());
+  for (const std::string& path : {png, jpg, pgm}) {
+    Image image;
+    const std::string m = boundError(path, ImageBound{64, 48}, image);
+    EXPECT_NE(m.find(path + ": image is 100x80, larger than the 64x48"), std::string::npos) << path << ": " << m;
+    EXPECT_EQ(image.width() * image.height(), 0) << path << ": pixels were read";
+    EXPECT_EQ(boundError(path, ImageBound{100, 80}, image), "") << path;
+    EXPECT_EQ(image.width(), 100) << path;
+  }
+  // A PNG whose header claims 30000x30000 (the pixels would not even be there): refused from the header alone.
+  std::string bytes = test::readFile(png);
+  const unsigned char huge[8] = {0, 0, 0x75, 0x30, 0, 0, 0x75, 0x30};
+  bytes.replace(16, 8, reinterpret_cast<const char*>(huge), 8);
+  const std::string claim = test::writeFile(dir.file("claim.png"), bytes);
+  Image image;
+  EXPECT_NE(boundError(claim, ImageBound{640, 480}, image).find("image is 30000x30000, larger than the 640x480"),
+            std::string::npos);
+  EXPECT_EQ(image.width() * image.height(), 0);
+}
+
 TEST(ImageCodecModule, AnUndecodableFileIsNamed) {
   test::TempDir dir("codec_bad");
   const std::string path = test::writeFile(dir.file("a.png"), "not a png at all");

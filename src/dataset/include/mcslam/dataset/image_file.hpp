@@ -14,14 +14,22 @@
 
 namespace mcslam {
 
+// The largest image a read accepts (0: no bound on that side). A file whose header says it is larger is refused
+// before its pixels are read or decoded: a small file (a PNG of 875 KB may say 30000x30000) must not take gigabytes.
+// PGM, PNG and JPEG are checked before decoding; other formats after.
+struct ImageBound {
+  int width = 0, height = 0;
+  bool admits(int w, int h) const { return (width <= 0 || w <= width) && (height <= 0 || h <= height); }
+};
+
 // Reads the image at `path` as 8-bit grey into `image` (resized; its buffer only grows). The format is told by
 // the content, not the name. Throws InputError naming the file: unreadable, malformed or truncated PGM,
-// undecodable image, or the codec module missing (then naming the module paths tried).
-void readGreyImageFile(const std::string& path, Image& image);
+// undecodable image, larger than `bound`, or the codec module missing (then naming the module paths tried).
+void readGreyImageFile(const std::string& path, Image& image, ImageBound bound = {});
 
 // Binary 8-bit PGM only (P5, maxval 255, '#' comments allowed in the header). Throws InputError naming the file
 // and what is wrong (magic, size, maxval, truncated pixels).
-void readPgmFile(const std::string& path, Image& image);
+void readPgmFile(const std::string& path, Image& image, ImageBound bound = {});
 
 // Writes `image` as binary PGM (P5, maxval 255). Throws InputError naming the file when it cannot.
 void writePgmFile(const std::string& path, const ImageView& image);
