@@ -49,6 +49,14 @@ def decode(data):
     }
 
 
+REORDER_WINDOW = 64  # docs/pose-protocol.md, rules for readers, 4
+
+
+def restarted(sequence, highest):
+    """Whether a record comes from a new run of the daemon, which counts `sequence` from 1 again (rule 4)."""
+    return highest is not None and (sequence == 1 or sequence + REORDER_WINDOW < highest)
+
+
 def format_pose(p):
     t = p["capture_time_ns"]
     whole = abs(t) // 1000000000  # truncated toward zero, as C's integer division
@@ -73,6 +81,7 @@ def main():
         sock.settimeout(args.timeout)
     print("listening on %s:%d" % sock.getsockname(), file=sys.stderr, flush=True)
     printed = 0
+    highest = None
     while args.count == 0 or printed < args.count:
         try:
             data = sock.recv(2048)
@@ -84,6 +93,11 @@ def main():
         except ValueError as e:
             print("pose_client: ignored a datagram: %s" % e, file=sys.stderr)
             continue
+        if restarted(pose["sequence"], highest):
+            print("pose_client: the daemon restarted (sequence %d after %d)" % (pose["sequence"], highest),
+                  file=sys.stderr, flush=True)
+            highest = None
+        highest = pose["sequence"] if highest is None else max(highest, pose["sequence"])
         print(format_pose(pose), flush=True)
         printed += 1
     return 0

@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <cstdio>
+
 #include "child_process.hpp"
 #include "daemon_fixture.hpp"
 #include "mcslam/pose_shm.hpp"
@@ -18,14 +21,17 @@ using pose::SegmentStatus;
 
 namespace {
 // A replay of a small dataset, looped as fast as it goes, publishing in the segment `shm`.
-std::string daemonConfig(const test::TempDir& dir, const std::string& shm, const std::string& mode = "0644") {
+std::string daemonConfig(const test::TempDir& dir, const std::string& shm, const std::string& mode = "0644",
+                         const std::string& udp_destination = "") {
   const std::string data = test::writeSmallDataset(dir.file("data"), 2, 20);
   std::filesystem::create_directories(dir.file("out"));
-  return test::writeFile(dir.file("mcslamd.yaml"),
-                         "log_level: info\nsource:\n  type: dataset\n  dataset:\n    path: " + data +
-                             "\n    rate: fastest\n    at_end: loop\n" + "publish:\n  shm:\n    name: " + shm +
-                             "\n    mode: \"" + mode +
-                             "\"\n    ring_length: 64\noutput:\n  directory: " + dir.file("out") + "\n");
+  return test::writeFile(
+      dir.file("mcslamd.yaml"),
+      "log_level: info\nsource:\n  type: dataset\n  dataset:\n    path: " + data +
+          "\n    rate: fastest\n    at_end: loop\n" + "publish:\n  shm:\n    name: " + shm + "\n    mode: \"" + mode +
+          "\"\n    ring_length: 64\n" +
+          (udp_destination.empty() ? "" : "  udp:\n    destinations: [\"" + udp_destination + "\"]\n") +
+          "output:\n  directory: " + dir.file("out") + "\n");
 }
 
 std::unique_ptr<test::ChildProcess> startDaemon(const std::string& config, const test::TempDir& dir,
@@ -147,4 +153,48 @@ TEST(ShmRestart, AModeLettingOthersWriteFailsTheConfigCheck) {
   EXPECT_NE(out.find("publish.shm.mode"), std::string::npos) << out;
   EXPECT_NE(out.find("0666"), std::string::npos) << out;
   EXPECT_NE(out.find(config), std::string::npos) << out;
+}
+
+// The UDP consumer written from docs/pose-protocol.md alone (tools/pose_client.py) goes on through a daemon's crash
+// and restart and says so: the new run's sequence starts at 1 again (the document's rule 4).
+TEST(ShmRestart, TheDocumentsUdpConsumerRecognizesARestartedDaemon) {
+  if (test::runCommand("python3 --version") != 0) GTEST_SKIP() << "python3 is not installed";
+  test::TempDir dir("udp-restart");
+  const std::string script = std::string(MCSLAM_TEST_DATA_DIR) + "/../../tools/pose_client.py";
+  test::ChildProcess client(
+      {"/usr/bin/env", "python3", script, "--bind", "127.0.0.1", "--port", "0", "--timeout", "60"},
+      dir.file("client.out"), dir.file("client.err"));
+  std::string port;
+  ASSERT_TRUE(test::eventually([&] {
+    const std::string hello = test::readFile(dir.file("client.err"));  // "listening on 127.0.0.1:PORT"
+    const auto colon = hello.rfind(':'), end = hello.find('\n');
+    if (colon == std::string::npos || end == std::string::npos || end < colon) return false;
+    port = hello.substr(colon + 1, end - colon - 1);
+    return true;
+  }));
+  const std::string config = daemonConfig(dir, test::uniqueShmName("udp-restart"), "0644", "127.0.0.1:" + port);
+  const auto lines = [&] {
+    const std::string out = test::readFile(dir.file("client.out"));
+    return static_cast<int>(std::count(out.begin(), out.end(), '\n'));
+  };
+  auto first = startDaemon(config, dir, "first");
+  ASSERT_TRUE(test::eventually([&] { return lines() >= 100; })) << logsOf(dir, "first");
+  ASSERT_TRUE(first->signal(SIGKILL));
+  first->wait();
+  const int before = lines();
+  auto second = startDaemon(config, dir, "second");
+  ASSERT_TRUE(test::eventually([&] {
+    return test::readFile(dir.file("client.err")).find("pose_client: the daemon restarted (sequence ") !=
+           std::string::npos;
+  })) << logsOf(dir, "second")
+      << test::readFile(dir.file("client.err"));
+  ASSERT_TRUE(test::eventually([&] { return lines() > before + 5; }));  // and goes on printing the new run's poses
+  unsigned long long sequence = 0, highest = 0;
+  const std::string err = test::readFile(dir.file("client.err"));
+  ASSERT_EQ(
+      std::sscanf(err.c_str() + err.find("restarted"), "restarted (sequence %llu after %llu)", &sequence, &highest), 2)
+      << err;
+  EXPECT_LT(sequence + 64, highest) << err;
+  ASSERT_TRUE(second->signal(SIGTERM));
+  EXPECT_EQ(second->wait(), 0) << logsOf(dir, "second");
 }
