@@ -65,13 +65,14 @@ int ProjectionSearch::search(const Map& map, const Rig& rig, const int32_t* slot
   const OctaveScales scales(p.scale_factor);
   const int c_begin = p.camera >= 0 ? p.camera : 0, c_end = p.camera >= 0 ? std::min(p.camera + 1, cams) : cams;
   int made = 0;
+  predicted_ = 0;
   for (int i = 0; i < n; ++i) {
     const int lm = slots[i];
     const Landmark& l = map.landmark(lm);
     if (!l.alive) continue;
     bool visible = false;
     for (int c = c_begin; c < c_end; ++c) {
-      if (!frame.present[c] || matches.keypointOf(lm, c) >= 0) continue;
+      const bool searched = frame.present[c] && matches.keypointOf(lm, c) < 0;
       const Vec3 p_c = T_c_w_[c] * l.p_w;
       if (p_c.z() < cos_field_[c] * p_c.norm()) continue;  // outside the camera's field of view
       Vec2 uv;
@@ -85,6 +86,8 @@ int ProjectionSearch::search(const Map& map, const Rig& rig, const int32_t* slot
         predicted =
             std::clamp(static_cast<int>(std::ceil(std::log(l.max_distance / dist) / log_scale)), 0, p.levels - 1);
       }
+      ++predicted_;
+      if (!searched) continue;
       visible = true;
       const double radius = p.radius_px * scales[predicted];
       const double r2 = radius * radius;

@@ -60,6 +60,7 @@ bool Tracker::track(const Map& map, const FrameFeatures& frame, uint64_t frame_i
   params.radius_px = options_.local_map_radius_px;
   search_.search(map, rig_.rig(), map.liveLandmarkSlots(), map.liveLandmarkCount(), coarse, frame, params, matches_,
                  &tracks_);
+  expected_matches_ = search_.predictedInImages();
   const int refined = poseFromMatches(map, frame, coarse, false, T_w_b);
   if (refined >= options_.min_tracked) {
     inliers = refined;
@@ -285,7 +286,7 @@ void Tracker::rescale(double s, const Vec3& center) {
 }
 
 float Tracker::quality(int inliers) const {
-  return static_cast<float>(std::min(1.0, inliers / std::max(1.0, 0.5 * last_keyframe_tracked_)));
+  return static_cast<float>(std::min(1.0, inliers / std::max(1.0, static_cast<double>(expected_matches_))));
 }
 
 }  // namespace mcslam

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <vector>
 
 #include "alloc_testing.hpp"
 #include "mcslam/calib/calibration_io.hpp"
@@ -24,9 +26,14 @@ struct RunResult {
   uint64_t allocations_after_warmup = 0;
   int first_metric = -1;                                    // first tracked frame whose pose says it is metric
   int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
+  std::vector<float> quality;                               // per frame (0 when not tracked)
 };
 
-RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, bool sim3) {
+// Changes frame i's features before they are processed (a camera that did not deliver, say).
+using FrameChange = std::function<void(int, FrameFeatures&)>;
+
+RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, bool sim3,
+                      const FrameChange& change = {}) {
   test::SyntheticSequence seq(rig, so);
   OverlapMap overlap(rig, OverlapOptions{});
   MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
@@ -34,10 +41,12 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
   Odometry odo(rig, oo, so.max_features);
   FrameFeatures f(rig.size(), so.max_features);
   RunResult r;
+  r.quality.assign(static_cast<std::size_t>(seq.frames()), 0.0f);
   uint64_t backend_thread_before = 0;  // allocations of the back-end thread before the warm-up ended
   for (int i = 0; i < seq.frames(); ++i) {
     if (i == so.warmup_frames) backend_thread_before = odo.backendThreadAllocations();
     seq.fill(i, f);
+    if (change) change(i, f);
     matcher.compute(f);
     PoseEstimate pose;
     alloc::ThreadScope scope;
@@ -48,6 +57,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
         std::printf("frame %d allocs %llu\n", i, (unsigned long long)scope.count());
     }
     if (pose.valid && pose.state == TrackingState::Tracking) {
+      r.quality[static_cast<std::size_t>(i)] = pose.quality;
       r.estimate.push_back({pose.t, pose.T_w_b});
       if (r.first_metric < 0 && pose.metric) r.first_metric = i;
       if (r.first_metric >= 0) {
@@ -81,6 +91,32 @@ TEST(OdometrySynthetic, FiveOverlappingCameras) {
   if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);  // keyframes, mapping and back-end (its thread too) included
   }
+}
+
+double meanQuality(const RunResult& r, int first, int last) {
+  double sum = 0;
+  for (int i = first; i < last; ++i) sum += r.quality[static_cast<std::size_t>(i)];
+  return sum / (last - first);
+}
+
+// The pose's quality is what share of the map's predictions in the images the pose's inliers are: below 1 while
+// tracking well (it used to saturate at 1 whenever half the last keyframe's landmarks were found), and lower when a
+// camera of the five stops delivering.
+TEST(OdometrySynthetic, QualityFallsWhenACameraIsLost) {
+  test::SyntheticSequenceOptions so;
+  constexpr int kLostFrom = 120, kLostTo = 160, kLostCamera = 4;
+  const RunResult r = runSequence(test::isecRig(), so, false, [&](int i, FrameFeatures& f) {
+    if (i < kLostFrom || i >= kLostTo) return;
+    f.present[kLostCamera] = 0;
+    f.sets[kLostCamera].count = 0;
+  });
+  EXPECT_EQ(r.stats.lost, 0u);
+  const double all = meanQuality(r, 80, kLostFrom), fewer = meanQuality(r, kLostFrom + 5, kLostTo);
+  std::printf("quality: five cameras %.3f, one of them lost %.3f\n", all, fewer);
+  EXPECT_GT(all, 0.2);
+  EXPECT_LT(all, 0.95);
+  EXPECT_LT(fewer, 0.9 * all);
+  EXPECT_GT(meanQuality(r, kLostTo + 10, so.frames), 0.9 * all) << "it comes back with the camera";
 }
 
 TEST(OdometrySynthetic, Stereo) {

@@ -30,7 +30,7 @@ struct PoseEstimate {
   uint64_t sequence = 0;
   SE3 T_w_b;  // body in world (world = body at the first frame)
   TrackingState state = TrackingState::NotInitialized;
-  float quality = 0;  // 0..1: share of expected landmark matches that were inliers
+  float quality = 0;  // 0..1: inliers over the landmark observations the map predicted in the images
   bool is_keyframe = false;
   bool valid = false;  // T_w_b holds an estimate
   // T_w_b.t is in metres. False when its unit is arbitrary: one camera, or a rig without overlap whose map

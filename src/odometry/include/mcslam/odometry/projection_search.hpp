@@ -61,6 +61,10 @@ class ProjectionSearch {
   // there again. With `count_visible` (the tracker's counts), landmarks predicted inside an image get visible++.
   int search(const Map& map, const Rig& rig, const int32_t* slots, int n, const SE3& T_w_b, const FrameFeatures& frame,
              const ProjectionSearchParams& params, FrameMatches& matches, LandmarkTracks* count_visible);
+  // Of the last search(): the (landmark, camera) pairs whose projection fell inside the camera's image at a scale it
+  // could be seen at, in every camera, whether it delivered this frame or not and whether or not the landmark was
+  // matched there before. What the map expects the frame to show.
+  int predictedInImages() const { return predicted_; }
 
   // Matches landmarks to keypoints of any camera by descriptor alone (no geometry): for recovery.
   int searchByDescriptor(const Map& map, const int32_t* slots, int n, const FrameFeatures& frame, int max_hamming,
@@ -72,6 +76,7 @@ class ProjectionSearch {
   // Per camera: cosine of the widest angle from the optical axis that any pixel of the image sees, with a
   // margin. A point outside that cone cannot project into the image: it is skipped before the lens model.
   std::vector<double> cos_field_;
+  int predicted_ = 0;
 };
 
 }  // namespace mcslam

@@ -52,7 +52,8 @@ class Tracker {
   void rescale(double s, const Vec3& center);
 
   const SE3& pose() const { return T_w_last_; }  // of the last frame
-  // Share of the last keyframe's landmarks that `inliers` is, up to 1.
+  // Share of what the local map predicted in the last frame's images (every camera, delivered or not) that
+  // `inliers` is, up to 1: it falls as a camera is lost, blurred or blacked out, and as the map stops matching.
   float quality(int inliers) const;
   double rotationTravelled() const { return rotation_travelled_; }  // radians, frame to frame, since the start
   uint64_t recoveries() const { return recoveries_; }  // frames tracked only through the descriptor fallback
@@ -91,6 +92,7 @@ class Tracker {
   uint64_t last_keyframe_frame_ = 0;
   SE3 last_keyframe_pose_;
   int last_keyframe_tracked_ = 0;
+  int expected_matches_ = 0;  // of the last frame: what the local map predicted in the images (the quality's base)
   double rotation_travelled_ = 0;
   uint64_t recoveries_ = 0;
 };
