@@ -100,8 +100,7 @@ double meanQuality(const RunResult& r, int first, int last) {
 }
 
 // The pose's quality is what share of the map's predictions in the images the pose's inliers are: below 1 while
-// tracking well (it used to saturate at 1 whenever half the last keyframe's landmarks were found), and lower when a
-// camera of the five stops delivering.
+// tracking well (a consumer can see it fall), and lower when a camera of the five stops delivering.
 TEST(OdometrySynthetic, QualityFallsWhenACameraIsLost) {
   test::SyntheticSequenceOptions so;
   constexpr int kLostFrom = 120, kLostTo = 160, kLostCamera = 4;

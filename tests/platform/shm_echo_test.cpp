@@ -1,6 +1,6 @@
-// mcslam-shm-echo when the segment misbehaves: a dead writer ends the wait with a message (it used to wait
-// forever), an inconsistent header ends it with one message (it used to print millions of lines), a truncated
-// segment does not kill it with SIGBUS, and a segment replaced under it (a restarted writer) is followed.
+// mcslam-shm-echo when the segment misbehaves: a dead writer ends the wait with a message (never a wait without
+// end), an inconsistent header ends it with one message (not a line per retry), a truncated segment does not kill
+// it with SIGBUS, and a segment replaced under it (a restarted writer) is followed.
 #include <gtest/gtest.h>
 
 #include <sstream>

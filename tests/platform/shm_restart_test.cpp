@@ -59,7 +59,7 @@ TEST(ShmRestart, AReaderFollowsTheDaemonThroughACrashAndARestart) {
 
   ASSERT_TRUE(first->signal(SIGKILL));
   EXPECT_EQ(first->wait(), 128 + SIGKILL);
-  EXPECT_TRUE(reader.writerRunning());  // the header still says so: what readers used to believe for ever
+  EXPECT_TRUE(reader.writerRunning());  // the header still says so: `state` alone cannot tell a crash
   EXPECT_EQ(reader.check(), SegmentStatus::WriterGone);
 
   auto second = startDaemon(config, dir, "second");
@@ -81,7 +81,7 @@ TEST(ShmRestart, AReaderFollowsTheDaemonThroughACrashAndARestart) {
   EXPECT_FALSE(pose::PoseShmReader().open(shm));  // its clean stop removed its own name
 }
 
-// Before: the daemon's next pose after the truncation ended it with SIGBUS.
+// A truncation of the segment must not end the daemon with SIGBUS at its next pose.
 TEST(ShmRestart, ADaemonWhoseSegmentIsTruncatedGoesOnInANewOne) {
   test::TempDir dir("shm-truncated");
   const std::string shm = test::uniqueShmName("truncated");
@@ -101,8 +101,7 @@ TEST(ShmRestart, ADaemonWhoseSegmentIsTruncatedGoesOnInANewOne) {
   EXPECT_EQ(daemon->wait(), 0) << logsOf(dir, "daemon");
 }
 
-// Before: the second daemon unlinked the first one's live segment and ran; the first one's stop then unlinked
-// the second one's.
+// A second daemon must not unlink the first one's live segment, nor the first one's stop the second one's.
 TEST(ShmRestart, ASecondDaemonRefusesTheNameOfARunningOne) {
   test::TempDir dir("shm-second");
   const std::string shm = test::uniqueShmName("second");
@@ -124,7 +123,7 @@ TEST(ShmRestart, ASecondDaemonRefusesTheNameOfARunningOne) {
   EXPECT_EQ(reader.check(), SegmentStatus::Stopped);
 }
 
-// Before: exit 2 ("bad configuration"), which the unit's RestartPreventExitStatus=2 never restarts.
+// Not exit 2 ("bad configuration"), which the unit's RestartPreventExitStatus=2 never restarts.
 TEST(ShmRestart, ANameAnotherUserOwnsEndsStartUpWithARestartableStatus) {
   if (::getuid() != 0) GTEST_SKIP() << "needs root to act as two users";
   test::TempDir dir("shm-owner");

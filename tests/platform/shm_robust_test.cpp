@@ -48,7 +48,7 @@ TEST(PoseShmRobust, AModeLettingOthersWriteIsRefused) {
   EXPECT_NO_THROW(platform::PoseShmWriter(name, 4, 0644));
 }
 
-// Before the guard, the first publish after the truncation ended the process with SIGBUS.
+// Without the guard, the first publish after the truncation would end the process with SIGBUS.
 TEST(PoseShmRobustDeathTest, TheWriterSurvivesATruncationAndSaysSo) {
   const std::string name = test::uniqueShmName("trunc-writer");
   EXPECT_EXIT(
@@ -137,7 +137,7 @@ TEST(PoseShmRobust, APidReusedAfterACrashDoesNotHoldTheName) {
   EXPECT_EQ(reader.check(), SegmentStatus::Live);
 }
 
-// Before, A's stop unlinked whatever had the name, here B's live segment.
+// A's stop must not unlink whatever has the name now, here B's live segment.
 TEST(PoseShmRobust, AStopUnlinksOnlyItsOwnSegment) {
   const std::string name = test::uniqueShmName("own");
   platform::PoseShmWriter a(name, 4, 0644);
