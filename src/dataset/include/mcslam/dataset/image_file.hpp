@@ -15,7 +15,7 @@
 namespace mcslam {
 
 // The largest image a read accepts (0: no bound on that side). A file whose header says it is larger is refused
-// before its pixels are read or decoded: a small file (a PNG of 875 KB may say 30000x30000) must not take gigabytes.
+// before its pixels are read or decoded: a compressed file may claim a size whose pixels would take gigabytes.
 // PGM, PNG and JPEG are checked before decoding; other formats after.
 struct ImageBound {
   int width = 0, height = 0;
