@@ -114,21 +114,24 @@ void PoseShmWriter::create(unsigned mode) {
   guard_ = pose::shm_guard::add(base_, size_, PROT_READ | PROT_WRITE);
 }
 
-void PoseShmWriter::initHeader() {
-  std::memset(base_, 0, size_);  // also faults every page in now, not on the first pose
-  pose::ShmHeader& h = header();
+void writeShmHeader(pose::ShmHeader& h, uint32_t ring_capacity, int64_t writer_pid, uint64_t writer_start_ticks) {
   h.version = pose::kShmVersion;
   h.header_size = pose::kShmHeaderSize;
   h.record_size = pose::kPacketSize;
   h.slot_size = pose::kShmSlotSize;
-  h.ring_capacity = capacity_;
+  h.ring_capacity = ring_capacity;
   h.ring_offset = pose::kShmHeaderSize + pose::kShmSlotSize;
-  h.writer_pid = ::getpid();
-  h.writer_start_ticks = pose::processStartTicks(static_cast<long>(::getpid()));
+  h.writer_pid = writer_pid;
+  h.writer_start_ticks = writer_start_ticks;
   h.start_time_ns = realtimeNs();
   h.state.store(pose::kWriterRunning, std::memory_order_relaxed);
   h.published.store(0, std::memory_order_relaxed);
   h.magic.store(pose::kShmMagic, std::memory_order_release);  // last: the header is complete
+}
+
+void PoseShmWriter::initHeader() {
+  std::memset(base_, 0, size_);  // also faults every page in now, not on the first pose
+  writeShmHeader(header(), capacity_, ::getpid(), pose::processStartTicks(static_cast<long>(::getpid())));
 }
 
 PoseShmWriter::~PoseShmWriter() {

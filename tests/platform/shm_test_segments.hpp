@@ -1,20 +1,42 @@
 #pragma once
 // Shared-memory segments made by hand for the tests of the pose segment's reader, writer and echo tool: a
-// header saying what the test needs (a writer pid that is alive or dead, a `published` no slot backs).
+// header saying what the test needs (a writer pid that is alive or dead, a `published` no slot backs); and the
+// records those tests publish.
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <string>
 
 #include "mcslam/pose_shm.hpp"
+#include "shm/pose_shm_writer.hpp"
 
 namespace mcslam::test {
 
 inline std::string uniqueShmName(const char* tag) {
   return std::string("/mcslam-test-") + tag + "-" + std::to_string(::getpid());
+}
+
+// Every field derived from the sequence, so a mix of two records is detectable.
+inline pose::PoseRecord recordFor(uint64_t seq) {
+  pose::PoseRecord r;
+  r.sequence = seq;
+  r.frame_sequence = seq * 3;
+  r.capture_time_ns = static_cast<int64_t>(seq) * 50000000;
+  r.publish_time_ns = static_cast<int64_t>(seq) * 7;
+  for (int i = 0; i < 3; ++i) r.position[i] = static_cast<double>(seq) + i * 0.25;
+  const double a = static_cast<double>(seq % 1000) * 1e-3;
+  r.orientation[0] = std::sin(a);
+  r.orientation[1] = 0;
+  r.orientation[2] = 0;
+  r.orientation[3] = std::cos(a);
+  r.tracking = static_cast<pose::Tracking>(seq % 3);
+  r.flags = static_cast<uint8_t>(seq & 3);
+  r.quality = static_cast<float>(seq % 100) / 100.0f;
+  return r;
 }
 
 // A version-1 segment, state running, with the given writer pid and `published`; the slots hold `fill`.
@@ -32,16 +54,8 @@ inline bool makeSegment(const std::string& name, int64_t writer_pid, uint64_t pu
   if (p == MAP_FAILED) return false;
   std::memset(static_cast<uint8_t*>(p) + pose::kShmHeaderSize, fill, size - pose::kShmHeaderSize);
   auto& h = *static_cast<pose::ShmHeader*>(p);
-  h.version = pose::kShmVersion;
-  h.header_size = pose::kShmHeaderSize;
-  h.record_size = pose::kPacketSize;
-  h.slot_size = pose::kShmSlotSize;
-  h.ring_capacity = capacity;
-  h.ring_offset = pose::kShmHeaderSize + pose::kShmSlotSize;
-  h.writer_pid = writer_pid;
-  h.state.store(pose::kWriterRunning);
+  platform::writeShmHeader(h, capacity, writer_pid, 0);
   h.published.store(published);
-  h.magic.store(pose::kShmMagic);
   ::munmap(p, size);
   return true;
 }

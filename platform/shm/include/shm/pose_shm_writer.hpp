@@ -59,4 +59,9 @@ class PoseShmWriter {
 // Empty when the mode is fine, else the reason.
 std::string shmModeProblem(unsigned mode);
 
+// Fills a zeroed segment's header: a ring of `ring_capacity` slots written by process `writer_pid` (which started
+// at `writer_start_ticks`, 0 = not recorded), state running, nothing published; the magic last, with release, so
+// that a reader that sees it sees the whole header. The writer's, and the tests' segments made by hand.
+void writeShmHeader(pose::ShmHeader& h, uint32_t ring_capacity, int64_t writer_pid, uint64_t writer_start_ticks);
+
 }  // namespace mcslam::platform
