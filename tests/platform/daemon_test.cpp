@@ -80,22 +80,6 @@ class RecordingProcessor : public FrameProcessor {
   std::vector<Seen>& seen_;
 };
 
-int udpReceiver(int& port) {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
-  socklen_t len = sizeof(a);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  port = ntohs(a.sin_port);
-  int big = 4 << 20;
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &big, sizeof(big));
-  timeval tv{0, 200000};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
-  return fd;
-}
-
 std::vector<pose::PoseRecord> drainUdp(int fd) {
   std::vector<pose::PoseRecord> out;
   uint8_t buf[512];
@@ -161,7 +145,8 @@ class DaemonTest : public ::testing::Test {
 
 TEST_F(DaemonTest, EveryPoseGoesToSharedMemoryUdpAndTheTrajectoryIdentically) {
   const std::string data = test::writeSmallDataset(dir_.file("data"), 3, 40);
-  const int rx = udpReceiver(udp_port_);
+  const test::UdpReceiver rx(INADDR_LOOPBACK, 200, 4 << 20);  // big enough for a run's datagrams
+  udp_port_ = rx.port();
   const std::string shm = "/mcslam-test-daemon-" + std::to_string(getpid());
   const DaemonConfig c = config(data, "    rate: fastest\n    at_end: idle\n", shm);
   std::vector<pose::PoseRecord> from_udp;
@@ -185,8 +170,7 @@ TEST_F(DaemonTest, EveryPoseGoesToSharedMemoryUdpAndTheTrajectoryIdentically) {
     EXPECT_FALSE(st.unscaled);  // the last pose (frame 39) is metric
     trajectory = d.trajectoryPath();
   }
-  from_udp = drainUdp(rx);
-  ::close(rx);
+  from_udp = drainUdp(rx.fd());
   ASSERT_EQ(from_shm.size(), 40u);
   ASSERT_EQ(from_udp.size(), 40u);
   const auto rows = readTum(trajectory);
@@ -236,7 +220,8 @@ TEST_F(DaemonTest, SlowProcessingDropsTheOldestRigFramesAndNeverStallsTheReplay)
 
 TEST_F(DaemonTest, TheNewestFrameSurvivesDropsAndPublishedFramesStayInOrder) {
   const std::string data = test::writeSmallDataset(dir_.file("data"), 2, 30, 32, 24, 5000000);
-  const int rx = udpReceiver(udp_port_);
+  const test::UdpReceiver rx(INADDR_LOOPBACK, 200, 4 << 20);  // big enough for a run's datagrams
+  udp_port_ = rx.port();
   const DaemonConfig c = config(data, "    at_end: idle\n");
   {
     Daemon d(c, std::make_unique<FakeProcessor>(15));
@@ -244,8 +229,7 @@ TEST_F(DaemonTest, TheNewestFrameSurvivesDropsAndPublishedFramesStayInOrder) {
     ASSERT_TRUE(waitFor([&] { return d.drained(); }));
     d.stop();
   }
-  const auto records = drainUdp(rx);
-  ::close(rx);
+  const auto records = drainUdp(rx.fd());
   ASSERT_FALSE(records.empty());
   for (std::size_t i = 1; i < records.size(); ++i) EXPECT_GT(records[i].frame_sequence, records[i - 1].frame_sequence);
   EXPECT_EQ(records.back().frame_sequence, 29u);  // dropping takes the oldest, never the newest
@@ -269,7 +253,8 @@ TEST_F(DaemonTest, NoDaemonThreadAllocatesPerFrameAfterWarmup) {
   SKIP_UNLESS_COUNTING_ALLOCATIONS();
   // 5 cameras, preloaded and looped, as fast as the pipeline takes them: thousands of frames quickly.
   const std::string data = test::writeSmallDataset(dir_.file("data"), 5, 20, 64, 48);
-  const int rx = udpReceiver(udp_port_);
+  const test::UdpReceiver rx(INADDR_LOOPBACK, 200, 4 << 20);  // big enough for a run's datagrams
+  udp_port_ = rx.port();
   const std::string shm = "/mcslam-test-alloc-" + std::to_string(getpid());
   const DaemonConfig c =
       config(data, "    rate: fastest\n    at_end: loop\n    preload: true\nwarmup_frames: 100\n", shm);
@@ -277,7 +262,6 @@ TEST_F(DaemonTest, NoDaemonThreadAllocatesPerFrameAfterWarmup) {
   d.start();
   ASSERT_TRUE(waitFor([&] { return d.stats().processed >= 3000; }, 100));
   d.stop();
-  ::close(rx);
   const DaemonStats s = d.stats();
   ASSERT_TRUE(s.warm);
   EXPECT_GE(s.frames_after_warmup, 2800u);

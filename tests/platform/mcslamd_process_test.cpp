@@ -190,15 +190,8 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
   test::TempDir dir("mcslamd");
   NotifyListener notify(dir.file("notify.sock"));
   ASSERT_TRUE(notify.ok());
-  const int rx = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(::bind(rx, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
-  socklen_t len = sizeof(a);
-  ::getsockname(rx, reinterpret_cast<sockaddr*>(&a), &len);
-  timeval tv{0, 300000};
-  ::setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+  const test::UdpReceiver rx(INADDR_LOOPBACK, 300);
+  ASSERT_GE(rx.fd(), 0);
 
   const std::string shm = "/mcslam-test-proc-" + std::to_string(getpid());
   const std::string config = test::writeFile(dir.file("mcslamd.yaml"),
@@ -210,7 +203,7 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
                                                  shm +
                                                  "\n    mode: \"0640\"\n    ring_length: 256\n"
                                                  "  udp:\n    destinations: [\"127.0.0.1:" +
-                                                 std::to_string(ntohs(a.sin_port)) +
+                                                 std::to_string(rx.port()) +
                                                  "\"]\n"
                                                  "output:\n  directory: out\n  extrinsics: refined/extrinsics.yaml\n");
   std::filesystem::create_directories(dir.file("out/refined"));
@@ -257,13 +250,12 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
   std::vector<pose::PoseRecord> from_udp;
   uint8_t buf[512];
   for (;;) {
-    const ssize_t n = ::recv(rx, buf, sizeof(buf), 0);
+    const ssize_t n = ::recv(rx.fd(), buf, sizeof(buf), 0);
     if (n <= 0) break;
     pose::PoseRecord r;
     ASSERT_EQ(pose::decodePacket(buf, static_cast<std::size_t>(n), r), pose::DecodeStatus::Ok);
     from_udp.push_back(r);
   }
-  ::close(rx);
   ASSERT_EQ(from_udp.size(), from_shm.size());
   ASSERT_GT(from_shm.size(), frames);
 
@@ -315,17 +307,24 @@ TEST(McslamdProcess, SimulatedRigReplayPublishesAccuratePosesEverywhereAndStopsC
   }
 }
 
+namespace {
+// A daemon that waits for its first frame: a small replay behind a software trigger at 0.1 Hz, whose first pulse
+// (and so the first frame) is 10 s away; no shared memory. Its configuration file in `dir`.
+std::string idleDaemonConfig(const test::TempDir& dir, const std::string& status_interval_s) {
+  test::writeSmallDataset(dir.file("data"), 2, 5);
+  return test::writeFile(dir.file("mcslamd.yaml"),
+                         "status_interval_s: " + status_interval_s +
+                             "\nsource:\n  type: dataset\n  dataset:\n    path: data\n"
+                             "trigger:\n  mode: software\n  rate_hz: 0.1\n"
+                             "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
+}
+}  // namespace
+
 TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
   test::TempDir dir("mcslamd-wd");
-  const std::string data = test::writeSmallDataset(dir.file("data"), 2, 5);
   NotifyListener notify(dir.file("notify.sock"));
   ASSERT_TRUE(notify.ok());
-  // Software trigger at 0.1 Hz: the first pulse (and so the first frame) is 10 s away.
-  const std::string config =
-      test::writeFile(dir.file("mcslamd.yaml"),
-                      "status_interval_s: 0.1\nsource:\n  type: dataset\n  dataset:\n    path: data\n"
-                      "trigger:\n  mode: software\n  rate_hz: 0.1\n"
-                      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
+  const std::string config = idleDaemonConfig(dir, "0.1");
   const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "100000", dir.file("log.txt"));
   const ReapOnExit reap_pid(pid);
   ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));
@@ -339,14 +338,9 @@ TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
 // as SIGTERM does, through the clean stop.
 TEST(McslamdProcess, OtherSignalsAreAnsweredAndSigquitStopsCleanly) {
   test::TempDir dir("mcslamd-signals");
-  const std::string data = test::writeSmallDataset(dir.file("data"), 2, 5);
   NotifyListener notify(dir.file("notify.sock"));
   ASSERT_TRUE(notify.ok());
-  const std::string config =
-      test::writeFile(dir.file("mcslamd.yaml"),
-                      "status_interval_s: 1000\nsource:\n  type: dataset\n  dataset:\n    path: data\n"
-                      "trigger:\n  mode: software\n  rate_hz: 0.1\n"
-                      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n");
+  const std::string config = idleDaemonConfig(dir, "1000");  // no status line from the timer
   const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "0", dir.file("log.txt"));
   const ReapOnExit reap_pid(pid);
   ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") == 1; })) << readAll(dir.file("log.txt"));

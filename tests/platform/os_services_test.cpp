@@ -75,45 +75,30 @@ TEST(SystemdNotifier, WithoutNotifySocketEverythingIsANoOp) {
 }
 
 TEST(UdpPoseSender, EveryDestinationGetsOneDecodableDatagramPerPose) {
-  const int rx = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(::bind(rx, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
-  socklen_t len = sizeof(a);
-  ::getsockname(rx, reinterpret_cast<sockaddr*>(&a), &len);
-  timeval tv{5, 0};
-  ::setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
-  const std::string dest = "127.0.0.1:" + std::to_string(ntohs(a.sin_port));
+  const test::UdpReceiver rx(INADDR_LOOPBACK, 5000);
+  ASSERT_GE(rx.fd(), 0);
+  const std::string dest = "127.0.0.1:" + std::to_string(rx.port());
   UdpPoseSender sender({resolveUdpDestination(dest, "publish.udp.destinations")});
   pose::PoseRecord r;
   r.sequence = 11;
   r.position[1] = 2.5;
   sender.send(r);
   uint8_t buf[256];
-  const ssize_t n = ::recv(rx, buf, sizeof(buf), 0);
+  const ssize_t n = ::recv(rx.fd(), buf, sizeof(buf), 0);
   ASSERT_EQ(n, static_cast<ssize_t>(pose::kPacketSize));
   pose::PoseRecord d;
   ASSERT_EQ(pose::decodePacket(buf, static_cast<std::size_t>(n), d), pose::DecodeStatus::Ok);
   EXPECT_EQ(d.sequence, 11u);
   EXPECT_EQ(d.position[1], 2.5);
   EXPECT_EQ(sender.sent(), 1u);
-  ::close(rx);
 }
 
 // A broadcast destination needs SO_BROADCAST (without it every send fails with EACCES): loopback's broadcast
 // address reaches a socket bound to any address.
 TEST(UdpPoseSender, ABroadcastDestinationIsSentTo) {
-  const int rx = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_ANY);
-  ASSERT_EQ(::bind(rx, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
-  socklen_t len = sizeof(a);
-  ::getsockname(rx, reinterpret_cast<sockaddr*>(&a), &len);
-  timeval tv{5, 0};
-  ::setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
-  const std::string dest = "127.255.255.255:" + std::to_string(ntohs(a.sin_port));
+  const test::UdpReceiver rx(INADDR_ANY, 5000);
+  ASSERT_GE(rx.fd(), 0);
+  const std::string dest = "127.255.255.255:" + std::to_string(rx.port());
   UdpPoseSender sender({resolveUdpDestination(dest, "publish.udp.destinations")});
   pose::PoseRecord r;
   r.sequence = 7;
@@ -121,8 +106,7 @@ TEST(UdpPoseSender, ABroadcastDestinationIsSentTo) {
   EXPECT_EQ(sender.failed(), 0u) << std::strerror(sender.lastErrno());
   EXPECT_EQ(sender.sent(), 1u);
   uint8_t buf[256];
-  EXPECT_EQ(::recv(rx, buf, sizeof(buf), 0), static_cast<ssize_t>(pose::kPacketSize));
-  ::close(rx);
+  EXPECT_EQ(::recv(rx.fd(), buf, sizeof(buf), 0), static_cast<ssize_t>(pose::kPacketSize));
 }
 
 TEST(UdpPoseSender, BadDestinationsNameTheKeyAndTheText) {

@@ -9,33 +9,13 @@
 
 #include "mcslam/pose_shm.hpp"
 #include "shm/pose_shm_writer.hpp"
+#include "shm_test_segments.hpp"
 
 using namespace mcslam;
 
 namespace {
-std::string uniqueName(const char* tag) { return std::string("/mcslam-test-") + tag + "-" + std::to_string(getpid()); }
-
-// Every field derived from the sequence, so a mix of two records is detectable.
-pose::PoseRecord recordFor(uint64_t seq) {
-  pose::PoseRecord r;
-  r.sequence = seq;
-  r.frame_sequence = seq * 3;
-  r.capture_time_ns = static_cast<int64_t>(seq) * 50000000;
-  r.publish_time_ns = static_cast<int64_t>(seq) * 7;
-  for (int i = 0; i < 3; ++i) r.position[i] = static_cast<double>(seq) + i * 0.25;
-  const double a = static_cast<double>(seq % 1000) * 1e-3;
-  r.orientation[0] = std::sin(a);
-  r.orientation[1] = 0;
-  r.orientation[2] = 0;
-  r.orientation[3] = std::cos(a);
-  r.tracking = static_cast<pose::Tracking>(seq % 3);
-  r.flags = static_cast<uint8_t>(seq & 3);
-  r.quality = static_cast<float>(seq % 100) / 100.0f;
-  return r;
-}
-
 bool consistent(const pose::PoseRecord& r) {
-  const pose::PoseRecord w = recordFor(r.sequence);
+  const pose::PoseRecord w = test::recordFor(r.sequence);
   uint8_t a[pose::kPacketSize], b[pose::kPacketSize];
   pose::encodePacket(r, a);
   pose::encodePacket(w, b);
@@ -44,7 +24,7 @@ bool consistent(const pose::PoseRecord& r) {
 }  // namespace
 
 TEST(PoseShm, ReaderSeesHeaderLatestAndRing) {
-  const std::string name = uniqueName("basic");
+  const std::string name = test::uniqueShmName("basic");
   platform::PoseShmWriter writer(name, 8, 0640);
   pose::PoseShmReader reader;
   std::string error;
@@ -54,7 +34,7 @@ TEST(PoseShm, ReaderSeesHeaderLatestAndRing) {
   EXPECT_EQ(reader.writerPid(), getpid());
   pose::PoseRecord r;
   EXPECT_EQ(reader.readLatest(r), pose::ReadStatus::NotYet);
-  for (uint64_t s = 1; s <= 20; ++s) writer.publish(recordFor(s));
+  for (uint64_t s = 1; s <= 20; ++s) writer.publish(test::recordFor(s));
   EXPECT_EQ(reader.published(), 20u);
   ASSERT_EQ(reader.readLatest(r), pose::ReadStatus::Ok);
   EXPECT_EQ(r.sequence, 20u);
@@ -69,7 +49,7 @@ TEST(PoseShm, ReaderSeesHeaderLatestAndRing) {
 }
 
 TEST(PoseShm, PermissionsComeFromTheConfigAndReadersMapReadOnly) {
-  const std::string name = uniqueName("perm");
+  const std::string name = test::uniqueShmName("perm");
   platform::PoseShmWriter writer(name, 4, 0640);
   struct stat st {};
   ASSERT_EQ(::stat(("/dev/shm" + name).c_str(), &st), 0);
@@ -90,7 +70,7 @@ TEST(PoseShm, OpeningSomethingElseFailsWithAReason) {
 }
 
 TEST(PoseShm, ConcurrentWriterAndReadersNeverSeeATornRecord) {
-  const std::string name = uniqueName("stress");
+  const std::string name = test::uniqueShmName("stress");
   platform::PoseShmWriter writer(name, 16, 0600);
   constexpr uint64_t kRecords = 300000;
   std::atomic<bool> done{false};
@@ -116,7 +96,7 @@ TEST(PoseShm, ConcurrentWriterAndReadersNeverSeeATornRecord) {
   uint64_t reads[2] = {0, 0}, torn[2] = {0, 0}, backwards[2] = {0, 0};
   std::thread r0(readerLoop, std::ref(reads[0]), std::ref(torn[0]), std::ref(backwards[0]));
   std::thread r1(readerLoop, std::ref(reads[1]), std::ref(torn[1]), std::ref(backwards[1]));
-  for (uint64_t s = 1; s <= kRecords; ++s) writer.publish(recordFor(s));
+  for (uint64_t s = 1; s <= kRecords; ++s) writer.publish(test::recordFor(s));
   done.store(true, std::memory_order_release);
   r0.join();
   r1.join();

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
-#include <algorithm>
 #include <cstdio>
 
 #include "child_process.hpp"
@@ -172,10 +171,7 @@ TEST(ShmRestart, TheDocumentsUdpConsumerRecognizesARestartedDaemon) {
     return true;
   }));
   const std::string config = daemonConfig(dir, test::uniqueShmName("udp-restart"), "0644", "127.0.0.1:" + port);
-  const auto lines = [&] {
-    const std::string out = test::readFile(dir.file("client.out"));
-    return static_cast<int>(std::count(out.begin(), out.end(), '\n'));
-  };
+  const auto lines = [&] { return test::lineCount(test::readFile(dir.file("client.out"))); };
   auto first = startDaemon(config, dir, "first");
   ASSERT_TRUE(test::eventually([&] { return lines() >= 100; })) << logsOf(dir, "first");
   ASSERT_TRUE(first->signal(SIGKILL));

@@ -17,12 +17,19 @@ using namespace mcslam;
 using pose::SegmentStatus;
 
 namespace {
-pose::PoseRecord recordFor(uint64_t seq) {
-  pose::PoseRecord r;
-  r.sequence = seq;
-  r.orientation[3] = 1;
-  r.position[0] = static_cast<double>(seq);
-  return r;
+// The segment of `name`, whose writer is gone, is taken over by a writer made now: a reader of the old segment sees
+// its writer gone, then the segment replaced; a new reader sees this process's live segment.
+void expectTakenOverByANewWriter(const std::string& name) {
+  pose::PoseShmReader old_reader;
+  ASSERT_TRUE(old_reader.open(name));
+  EXPECT_EQ(old_reader.check(), SegmentStatus::WriterGone);
+  platform::PoseShmWriter writer(name, 4, 0644);
+  EXPECT_EQ(old_reader.check(), SegmentStatus::Replaced);
+  pose::PoseShmReader reader;
+  ASSERT_TRUE(reader.open(name));
+  EXPECT_EQ(reader.writerPid(), ::getpid());
+  EXPECT_EQ(reader.header().writer_start_ticks, pose::processStartTicks(::getpid()));
+  EXPECT_EQ(reader.check(), SegmentStatus::Live);
 }
 
 template <typename Error>
@@ -54,10 +61,10 @@ TEST(PoseShmRobustDeathTest, TheWriterSurvivesATruncationAndSaysSo) {
   EXPECT_EXIT(
       {
         platform::PoseShmWriter writer(name, 8, 0644);
-        for (uint64_t s = 1; s <= 3; ++s) writer.publish(recordFor(s));
+        for (uint64_t s = 1; s <= 3; ++s) writer.publish(test::recordFor(s));
         const bool lost_before = writer.lost();
         if (!test::truncateSegment(name)) std::_Exit(10);
-        for (uint64_t s = 4; s <= 20; ++s) writer.publish(recordFor(s));
+        for (uint64_t s = 4; s <= 20; ++s) writer.publish(test::recordFor(s));
         if (lost_before || !writer.lost()) std::_Exit(11);
         writer.markStopped();  // the truncated file is still ours: its name goes
         pose::PoseShmReader reader;
@@ -75,7 +82,7 @@ TEST(PoseShmRobustDeathTest, AGuardedReaderSurvivesATruncationAndSeesIt) {
         pose::PoseShmReader::guardAgainstTruncation();
         pose::PoseShmReader reader;
         if (!reader.open(name)) std::_Exit(10);
-        for (uint64_t s = 1; s <= 5; ++s) writer.publish(recordFor(s));
+        for (uint64_t s = 1; s <= 5; ++s) writer.publish(test::recordFor(s));
         pose::PoseRecord r;
         if (reader.readLatest(r) != pose::ReadStatus::Ok || reader.check() != SegmentStatus::Live) std::_Exit(11);
         if (!test::truncateSegment(name)) std::_Exit(12);
@@ -102,15 +109,7 @@ TEST(PoseShmRobust, ANameARunningWriterHoldsIsRefusedWithItsPid) {
 TEST(PoseShmRobust, ASegmentADeadWriterLeftIsTakenOver) {
   const std::string name = test::uniqueShmName("dead");
   ASSERT_TRUE(test::makeSegment(name, test::deadPid(), 7));
-  pose::PoseShmReader old_reader;
-  ASSERT_TRUE(old_reader.open(name));
-  EXPECT_EQ(old_reader.check(), SegmentStatus::WriterGone);
-  platform::PoseShmWriter writer(name, 4, 0644);
-  EXPECT_EQ(old_reader.check(), SegmentStatus::Replaced);
-  pose::PoseShmReader reader;
-  ASSERT_TRUE(reader.open(name));
-  EXPECT_EQ(reader.writerPid(), ::getpid());
-  EXPECT_EQ(reader.check(), SegmentStatus::Live);
+  expectTakenOverByANewWriter(name);
 }
 
 // A crashed writer's pid given to a later process: the start time the writer recorded tells them apart, so the
@@ -126,15 +125,7 @@ TEST(PoseShmRobust, APidReusedAfterACrashDoesNotHoldTheName) {
   ASSERT_TRUE(test::editSegment(name, [&](pose::ShmHeader& h, pose::ShmSlot*, uint32_t) {
     h.writer_start_ticks = its_start + 1;  // the writer that made it started at another time
   }));
-  pose::PoseShmReader old_reader;
-  ASSERT_TRUE(old_reader.open(name));
-  EXPECT_EQ(old_reader.check(), SegmentStatus::WriterGone);
-  platform::PoseShmWriter writer(name, 4, 0644);
-  EXPECT_EQ(old_reader.check(), SegmentStatus::Replaced);
-  pose::PoseShmReader reader;
-  ASSERT_TRUE(reader.open(name));
-  EXPECT_EQ(reader.header().writer_start_ticks, pose::processStartTicks(::getpid()));
-  EXPECT_EQ(reader.check(), SegmentStatus::Live);
+  expectTakenOverByANewWriter(name);
 }
 
 // A's stop must not unlink whatever has the name now, here B's live segment.
@@ -196,7 +187,7 @@ TEST(PoseShmRobust, CheckTellsTheCasesApartWithoutAllocating) {
 
   // A new writer under the name (what a restarted daemon does): the old mapping is Replaced, reattach() finds
   // the new one.
-  a->publish(recordFor(1));
+  a->publish(test::recordFor(1));
   auto b = std::make_unique<platform::PoseShmWriter>(name, 16, 0644);
   EXPECT_EQ(reader.check(), SegmentStatus::Replaced);
   EXPECT_EQ(reader.published(), 1u);

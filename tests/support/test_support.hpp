@@ -2,6 +2,7 @@
 // Helpers shared by the tests.
 #include <sys/types.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -33,6 +34,23 @@ std::string readFile(const std::string& path);
 
 // Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
 int runCommand(const std::string& command, std::string* output = nullptr);
+
+// A UDP socket bound to `address` (IPv4, host byte order: INADDR_LOOPBACK, INADDR_ANY) on a port the kernel
+// picks, whose receives give up after `timeout_ms`, with a receive buffer of `buffer_bytes` (0: the system's);
+// closed with the object. fd() < 0 when it could not be made.
+class UdpReceiver {
+ public:
+  UdpReceiver(uint32_t address, int timeout_ms, int buffer_bytes = 0);
+  ~UdpReceiver();
+  UdpReceiver(const UdpReceiver&) = delete;
+  UdpReceiver& operator=(const UdpReceiver&) = delete;
+  int fd() const { return fd_; }
+  int port() const { return port_; }
+
+ private:
+  int fd_ = -1;
+  int port_ = 0;
+};
 
 // Forks a child that receives SIGKILL when the test process ends, however it ends (a ctest timeout included), so
 // that no daemon or fake camera outlives its test. Returns fork()'s value.
