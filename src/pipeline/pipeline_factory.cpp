@@ -15,7 +15,7 @@ std::string effectivePipelineConfig(const YAML::Node& slam, const std::string& s
 std::unique_ptr<FrameProcessor> createPipeline(const YAML::Node& slam, const std::string& source, const Rig& rig,
                                                bool live) {
   PipelineConfig config = parsePipelineConfig(slam, source, rig);
-  config.places.wait_for_correction = !live;
+  config.places.repeatable = !live;
   return std::make_unique<SlamPipeline>(rig, config);
 }
 

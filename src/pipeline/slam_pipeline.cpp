@@ -63,7 +63,11 @@ void SlamPipeline::computeFeatures(const RigFrameView& frame, FrameFeatures& out
 void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out,
                          PipelineTiming& timing) {
   odometry_.process(features, sequence, out);
-  if (places_) places_->afterOdometry(features, sequence, odometry_, out);
+  if (places_) {
+    const auto start = std::chrono::steady_clock::now();
+    places_->afterOdometry(features, sequence, odometry_, out);
+    timing.places_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
   if (handover_) {
     rig_after_[frames_tracked_ % 2].follow(odometry_.rigState());  // by value, allocates nothing
     ++frames_tracked_;

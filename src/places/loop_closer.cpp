@@ -15,39 +15,74 @@ int32_t LoopCloser::findRoot(int32_t s) {
   return s;
 }
 
+bool LoopCloser::alone(int32_t segment) {
+  if (findRoot(segment) != segment) return false;
+  for (int32_t s = 0; s < PlaceMap::kMaxSegments; ++s)
+    if (s != segment && findRoot(s) == segment) return false;
+  return true;
+}
+
 LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera)
     : options_(options),
       verifier_(rig, options, scale_factor, max_features_per_camera),
       loops_(static_cast<std::size_t>(options.max_loops)),
       segment_root_(PlaceMap::kMaxSegments),
       roots_(PlaceMap::kMaxSegments),
-      correction_(options.max_keyframes, options.max_loops) {
+      correction_(options.max_keyframes, options.max_loops),
+      detect_features_(rig.size(), max_features_per_camera),
+      detect_words_(rig.size(), max_features_per_camera) {
+  detection_.closer = this;
   clear();
 }
 
 void LoopCloser::clear() {
+  detection_task_.collect();
   correction_wanted_ = false;
   loop_count_ = 0;
   for (int32_t s = 0; s < PlaceMap::kMaxSegments; ++s) segment_root_[static_cast<std::size_t>(s)] = s;
   pending_keyframe_ = -1;
 }
 
-bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const FrameWords& words, PlaceMap& map,
-                            const PlaceDatabase& database) {
+void LoopCloser::startDetection(int slot, const FrameFeatures& features, const FrameWords& words, const PlaceMap& map,
+                                const PlaceDatabase& database) {
   // While the map's correction is being solved, its poses are about to move: a detection now would be measured
   // against the old ones (and find the loop just closed again).
   if (correcting()) {
     ++stats_.skipped;
     pending_keyframe_ = -1;
-    return false;
+    return;
   }
-  const PlaceKeyframe& k = map.keyframe(slot);
+  ++stats_.queries;
+  detect_slot_ = slot;
+  detect_map_ = &map;
+  detect_database_ = &database;
+  detect_features_ = features;  // same capacities: no allocation
+  detect_words_ = words;
+  detection_task_.start(detection_);
+}
+
+void LoopCloser::detect() {
+  const PlaceMap& map = *detect_map_;
+  const PlaceKeyframe& k = map.keyframe(detect_slot_);
   const auto reachable = [&](int other) {
     const PlaceKeyframe& o = map.keyframe(other);
-    return other == slot || (o.segment == k.segment && k.id - o.id < options_.loop_min_keyframes_apart);
+    return other == detect_slot_ || (o.segment == k.segment && k.id - o.id < options_.loop_min_keyframes_apart);
   };
-  ++stats_.queries;
-  const RelocalizationResult r = verifier_.locate(features, words, map, database, -1, reachable);
+  found_ = verifier_.locate(detect_features_, detect_words_, map, *detect_database_, -1, reachable);
+}
+
+bool LoopCloser::collectDetection(const PlaceMap& map, bool wait) {
+  if (!detection_task_.running()) return false;
+  if (!detection_task_.ready()) {
+    if (!wait) return false;
+    ++stats_.waits;
+  }
+  detection_task_.collect();
+  stats_.last_detection_ms = detection_task_.lastMilliseconds();
+  return decide(detect_slot_, found_, map);
+}
+
+bool LoopCloser::decide(int slot, const RelocalizationResult& r, const PlaceMap& map) {
   if (!r.ok) {
     pending_keyframe_ = -1;
     return false;
@@ -57,6 +92,7 @@ bool LoopCloser::onKeyframe(int slot, const FrameFeatures& features, const Frame
     pending_keyframe_ = -1;
     return false;
   }
+  const PlaceKeyframe& k = map.keyframe(slot);
   const SE3 correction = r.T_w_b * k.T_w_k.inverse();  // moves the drifted keyframe onto the recognized place
   const int64_t candidate = map.keyframe(r.keyframe).id;
   const bool confirmed = consistentWithLast(slot, map, correction);

@@ -91,18 +91,29 @@ LoopCorrection::Outcome LoopCorrection::take(PlaceMap& map, bool wait) {
   return Outcome::Applied;
 }
 
+int LoopCorrection::newestNode(int32_t segment) const {
+  return segment < graph_segments_ ? newest_node_[static_cast<std::size_t>(segment)] : -1;
+}
+
 void LoopCorrection::apply(PlaceMap& map) {
   for (int32_t s = 0; s < map.segments(); ++s) {
-    SE3& delta = segment_delta_[static_cast<std::size_t>(s)];
-    const int newest = s < graph_segments_ ? newest_node_[static_cast<std::size_t>(s)] : -1;
-    if (newest >= 0) {
-      delta = graph_.pose(newest) * newest_pose_before_[static_cast<std::size_t>(s)].inverse();
-    } else {
-      const int32_t parent = map.continuesFrom(s);
-      delta = parent >= 0 ? segment_delta_[static_cast<std::size_t>(parent)] : SE3();
-    }
-    map.setSegmentPose(s, delta * map.segmentPose(s));
+    const int newest = newestNode(s);
+    if (newest >= 0)
+      segment_delta_[static_cast<std::size_t>(s)] =
+          graph_.pose(newest) * newest_pose_before_[static_cast<std::size_t>(s)].inverse();
   }
+  // A segment with no keyframe in the graph (begun during the solve, or without keyframes) moves with the nearest
+  // segment up the chain it continues that has one; a reused segment may continue one numbered after it.
+  for (int32_t s = 0; s < map.segments(); ++s) {
+    if (newestNode(s) >= 0) continue;
+    int32_t parent = map.continuesFrom(s);
+    for (int hops = 0; parent >= 0 && newestNode(parent) < 0 && hops < PlaceMap::kMaxSegments; ++hops)
+      parent = map.continuesFrom(parent);
+    segment_delta_[static_cast<std::size_t>(s)] =
+        parent >= 0 && newestNode(parent) >= 0 ? segment_delta_[static_cast<std::size_t>(parent)] : SE3();
+  }
+  for (int32_t s = 0; s < map.segments(); ++s)
+    map.setSegmentPose(s, segment_delta_[static_cast<std::size_t>(s)] * map.segmentPose(s));
   for (int slot = 0; slot < map.capacity(); ++slot) {
     const PlaceKeyframe& k = map.keyframe(slot);
     if (!k.alive) continue;

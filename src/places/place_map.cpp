@@ -141,10 +141,21 @@ void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {
 
 int32_t PlaceMap::createSegment(const SE3& T_w_o, bool placed, int32_t continues) {
   if (segment_count_ == kMaxSegments) return -1;
-  segment_T_w_o_[static_cast<std::size_t>(segment_count_)] = T_w_o;
-  segment_placed_[static_cast<std::size_t>(segment_count_)] = placed ? 1 : 0;
-  segment_continues_[static_cast<std::size_t>(segment_count_)] = continues;
+  setUpSegment(segment_count_, T_w_o, placed, continues);
   return segment_count_++;
+}
+
+void PlaceMap::reuseSegment(int32_t segment, const SE3& T_w_o, bool placed, int32_t continues) {
+  for (int32_t& parent : segment_continues_)
+    if (parent == segment) parent = -1;
+  setUpSegment(segment, T_w_o, placed, continues);
+}
+
+void PlaceMap::setUpSegment(int32_t segment, const SE3& T_w_o, bool placed, int32_t continues) {
+  const auto s = static_cast<std::size_t>(segment);
+  segment_T_w_o_[s] = T_w_o;
+  segment_placed_[s] = placed ? 1 : 0;
+  segment_continues_[s] = continues;
 }
 
 void PlaceMap::moveSegment(int32_t segment, const SE3& T_w_o) {

@@ -31,7 +31,10 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
 
 void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry,
                                 PoseEstimate& out) {
-  takeCorrection(options_.wait_for_correction);
+  // The loop detection started on an earlier keyframe reads the map and the database: a frame that may write them
+  // takes its result first, waiting if need be; a frame that only tracks takes it once it is ready.
+  collectLoopDetection(/*wait=*/!onlyReadsMap(odometry, out));
+  takeCorrection(options_.repeatable);
   followSegment(odometry);
   // Before the keyframes settled in this frame join: they are in the new unit already.
   for (const Odometry::Rescale& r : odometry.rescales()) map_.rescaleSegment(segment_, r.s, r.center);
@@ -71,9 +74,10 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
   const SE3 T_w_o = segment_ >= 0 ? map_.segmentPose(segment_) : SE3();
   // The first map of a run that reuses a saved one is nowhere in it until recognized.
   const bool placed = segment_ >= 0 ? map_.placed(segment_) : !loaded_;
-  const int32_t s = map_.createSegment(T_w_o, placed, segment_);
+  int32_t s = map_.createSegment(T_w_o, placed, segment_);
+  if (s < 0) s = reuseSegment(T_w_o, placed);
   if (s < 0) {
-    spdlog::warn("place memory: more than {} odometry maps; the newest keeps the last one's frame",
+    spdlog::warn("place memory: {} odometry maps with keyframes or loops; the newest keeps the last one's frame",
                  PlaceMap::kMaxSegments);
     return;
   }
@@ -82,7 +86,30 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
   segment_ = s;
 }
 
+bool PlaceMemory::onlyReadsMap(const Odometry& odometry, const PoseEstimate& out) const {
+  return out.state == TrackingState::Tracking && odometry.stats().initializations == initializations_seen_ &&
+         odometry.rescales().empty() && odometry.settledKeyframes().empty() && segment_ >= 0 && map_.placed(segment_) &&
+         !localize_only_;
+}
+
+void PlaceMemory::collectLoopDetection(bool wait) { loop_closer_.collectDetection(map_, wait); }
+
+// Every segment is taken: one left without keyframes (culled, dropped when the run entered a saved map, or lost
+// before its first keyframe) that no loop joined is made anew. Not while a correction is being solved: the graph
+// names segments as they were.
+int32_t PlaceMemory::reuseSegment(const SE3& T_w_o, bool placed) {
+  if (loop_closer_.correcting()) return -1;
+  for (int32_t s = 0; s < map_.segments(); ++s) {
+    if (s == segment_ || map_.hasKeyframes(s) || !loop_closer_.alone(s)) continue;
+    map_.reuseSegment(s, T_w_o, placed, segment_);
+    ++stats_.segments_reused;
+    return s;
+  }
+  return -1;
+}
+
 void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
+  collectLoopDetection(/*wait=*/true);  // the frame's keyframe before this one started one
   const Map& local = odometry.map();
   const Keyframe& kf = local.keyframe(odometry_slot);
   const SE3 T_w_k = map_.segmentPose(segment_) * kf.T_w_b;
@@ -123,7 +150,8 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   // Sim(3), which is not built yet.
   if (options_.loop_closure && odometry.rigState().metric()) {
     loop_closer_.setRig(odometry.trackingRig());
-    loop_closer_.onKeyframe(slot, kf.features, words_, map_, database_);
+    loop_closer_.startDetection(slot, kf.features, words_, map_, database_);
+    if (options_.repeatable) collectLoopDetection(/*wait=*/true);
   }
 }
 
@@ -149,6 +177,7 @@ void PlaceMemory::makeRoom() {
 }
 
 void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out) {
+  collectLoopDetection(/*wait=*/true);  // one started by this frame's keyframe shares the database's query
   ++stats_.relocalization_queries;
   words_.compute(vocabulary_, frame);
   relocalizer_.setRig(odometry.trackingRig());
@@ -220,6 +249,7 @@ bool PlaceMemory::enterWorld(uint64_t frame_index) {
 }
 
 void PlaceMemory::place(const FrameFeatures& frame, uint64_t frame_index, const Odometry& odometry, const SE3& T_o_b) {
+  collectLoopDetection(/*wait=*/true);  // one started by this frame's keyframe shares the database's query
   words_.compute(vocabulary_, frame);
   relocalizer_.setRig(odometry.trackingRig());
   const int32_t own = segment_;

@@ -81,6 +81,24 @@ TEST(LoopCorrection, WhatWasMadeDuringTheSolveMovesWithItsSegment) {
   EXPECT_LT((d.map.keyframe(b).T_w_k.t - (d.map.keyframe(39).T_w_k * step * step).t).norm(), 1e-9);
 }
 
+// A reused segment (PlaceMap::reuseSegment) may continue one numbered after it: with no keyframe of its own in the
+// graph it still moves with the segment up its chain that has one.
+TEST(LoopCorrection, ASegmentWithoutKeyframesMovesWithTheSegmentItContinuesWhateverTheirNumbers) {
+  DriftedLoop d = driftedLoop(40);
+  const int32_t reused = d.map.createSegment(SE3());  // to be set up anew below
+  const int32_t later = d.map.createSegment(d.map.segmentPose(d.segment), true, d.segment);
+  d.map.reuseSegment(reused, d.map.segmentPose(later), true, later);
+  const std::vector<int32_t> roots = {0, 1, 2};
+  LoopCorrection correction(64, 4);
+  correction.start(d.map, {&d.loop, 1}, roots);
+  ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
+  const SE3& moved = d.map.segmentPose(d.segment);
+  EXPECT_GT(moved.t.norm(), 0.01);  // the loop moved the segment's frame
+  EXPECT_LT((d.map.segmentPose(later).t - moved.t).norm(), 1e-9);
+  EXPECT_LT((d.map.segmentPose(reused).t - moved.t).norm(), 1e-9);
+  EXPECT_LT(rotationAngle(d.map.segmentPose(reused).R, moved.R), 1e-9);
+}
+
 TEST(LoopCorrection, ASegmentMovedDuringTheSolveMakesItStale) {
   DriftedLoop d = driftedLoop(40);
   const SE3 before = d.map.keyframe(20).T_w_k;

@@ -42,6 +42,27 @@ TEST(PlaceMap, KeyframesChainWithinTheirSegment) {
   EXPECT_EQ(map.size(), 3);
 }
 
+// A robot's life can start more odometry maps than there are segments: with all taken, one left without
+// keyframes is set up anew, and what continued it no longer does.
+TEST(PlaceMap, ASegmentWithoutKeyframesCanBeReusedWhenAllAreTaken) {
+  PlaceMap map(8, 10);
+  for (int32_t s = 0; s < PlaceMap::kMaxSegments; ++s) ASSERT_EQ(map.createSegment(SE3(), true, s - 1), s);
+  EXPECT_EQ(map.createSegment(SE3()), -1);
+  const int a = map.createKeyframe(5, 1, 1, SE3(), SE3());
+  EXPECT_TRUE(map.hasKeyframes(5));
+  EXPECT_FALSE(map.hasKeyframes(7));
+  const SE3 T_w_o(Mat3::Identity(), Vec3(4, 5, 6));
+  map.reuseSegment(7, T_w_o, /*placed=*/false, /*continues=*/1023);
+  EXPECT_EQ(map.segments(), PlaceMap::kMaxSegments);
+  EXPECT_EQ(map.segmentPose(7).t, T_w_o.t);
+  EXPECT_FALSE(map.placed(7));
+  EXPECT_EQ(map.continuesFrom(7), 1023);
+  EXPECT_EQ(map.continuesFrom(8), -1);  // it continued the segment that was 7
+  EXPECT_EQ(map.continuesFrom(9), 8);
+  map.eraseKeyframe(a);
+  EXPECT_FALSE(map.hasKeyframes(5));
+}
+
 TEST(PlaceMap, PointsAreFoundByTheirNode) {
   PlaceMap map(2, 6);
   const int k = map.createKeyframe(map.createSegment(SE3()), 0, 0, SE3(), SE3());

@@ -35,6 +35,7 @@ struct RunOptions {
   std::size_t max_frames = 0;
   std::string black_text, skip_text;  // fault injection: frame ranges "A-B"
   bool no_loop_closure = false;
+  bool live = false;
   std::size_t first_frame = 0;
   std::string map_in, map_out;
   bool localize = false;
@@ -89,6 +90,9 @@ void addOptions(CLI::App& app, RunOptions& o) {
   app.add_flag("--quiet", o.quiet, "No progress bar");
   app.add_flag("--no-loop-closure", o.no_loop_closure,
                "Relocalize, but close no loop (places.loop_closure: false), for comparisons");
+  app.add_flag("--live", o.live,
+               "Take the loop closer's results as mcslamd does, the first frame they are ready, instead of waiting "
+               "for them at fixed frames: runs no longer repeat exactly");
   app.add_option("--black", o.black_text,
                  "Fault injection: every camera's image of frames A-B (dataset indices) is black, as if the rig were "
                  "covered");
@@ -296,6 +300,7 @@ int runDataset(const RunOptions& o) {
   PipelineConfig config =
       parsePipelineConfig(slamSection(o.config_path), o.config_path.empty() ? "defaults" : o.config_path, ds.rig());
   if (o.no_loop_closure) config.places.loop_closure = false;
+  config.places.repeatable = !o.live;
   if (o.localize && o.map_in.empty()) throw InputError("--localize needs a map to localize in (--map-in)");
   if (o.localize && !o.map_out.empty())
     throw InputError("--map-out with --localize: a map only localized in is not changed, there is nothing to save");

@@ -81,13 +81,14 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
                            int cameras, double wall_seconds) const {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw InputError(path + ": cannot write stats file");
-  std::vector<double> features, tracking, optimization, total;
+  std::vector<double> features, tracking, optimization, place_memory, total;
   uint64_t state_count[4] = {0, 0, 0, 0};
   int interpolated = 0, unknown_scale = 0, unanchored = 0;
   for (const FrameRecord& r : frames_) {
     features.push_back(r.timing.features_ms);
     tracking.push_back(r.timing.tracking_ms);
     optimization.push_back(r.timing.optimization_ms);
+    place_memory.push_back(r.timing.places_ms);
     total.push_back(r.timing.total_ms);
     ++state_count[static_cast<int>(r.pose.state)];
     interpolated += r.interpolated ? 1 : 0;
@@ -149,6 +150,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("relocalization_queries").value(p.relocalization_queries);
     j.key("relocalizations").value(p.relocalizations);
     j.key("segments").value(places->map().segments());  // odometry maps started, the first one included
+    j.key("segments_reused").value(p.segments_reused);
     j.key("last_relocalized_frame").value(static_cast<long long>(p.last_relocalized_frame));
     const LoopStats& l = places->loopStats();
     j.key("loop_queries").value(l.queries);
@@ -156,6 +158,8 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("loops_consistent").value(l.consistent);
     j.key("loop_closures").value(l.closures);
     j.key("map_merges").value(l.merges);
+    j.key("loop_queries_skipped").value(l.skipped);  // while a correction was being solved
+    j.key("loop_detection_waits").value(l.waits);    // frames that waited for the detection thread (--live)
     j.key("world_revision").value(static_cast<unsigned long long>(places->worldRevision()));
     j.key("map_loaded").value(places->mapLoaded());
     j.key("placed_frame").value(static_cast<long long>(p.placed_frame));  // first frame recognized in the loaded map
@@ -174,6 +178,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   const std::pair<const char*, Summary> stages[] = {{"feature_extraction", summarize(features)},
                                                     {"tracking_and_mapping", summarize(tracking)},
                                                     {"optimization", summarize(optimization)},
+                                                    {"place_memory", summarize(place_memory)},
                                                     {"total", summarize(total)}};
   for (const auto& [name, sum] : stages) {
     j.key(name).beginObject();

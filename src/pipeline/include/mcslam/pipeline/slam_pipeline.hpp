@@ -14,6 +14,7 @@ struct PipelineTiming {
   double features_ms = 0;      // ORB extraction and multi-view features
   double tracking_ms = 0;      // pose estimation, keyframe decision, new landmarks
   double optimization_ms = 0;  // sliding-window back-end
+  double places_ms = 0;        // place memory on the processing thread (relocalization, keyframes, loops)
   double total_ms = 0;
 };
 

@@ -1,14 +1,17 @@
 #pragma once
 // Loop closure over the place map: each new place keyframe looks for an older place it sees again (the database,
 // then the relocalizer's verification: generalized P3P, guided search, strict acceptance), among keyframes the
-// odometry can no longer reach (of another segment, or `loop_min_keyframes_apart` keyframes older). A loop is
-// accepted when two consecutive keyframes of the segment find it with the same correction (zero false closures
-// is the rule). It then becomes an edge of the pose graph over every place keyframe, solved on a thread of its own
-// while frames go on (LoopCorrection); at a frame boundary the map takes the solution. Fixed memory.
+// odometry can no longer reach (of another segment, or `loop_min_keyframes_apart` keyframes older). That detection
+// runs on a thread of its own, on copies of the keyframe's features and words, while the map and the database stay
+// as they were when it started (their writer takes its result before it writes them again). A loop is accepted
+// when two consecutive keyframes of the segment find it with the same correction (zero false closures is the
+// rule). It then becomes an edge of the pose graph over every place keyframe, solved on another thread while frames
+// go on (LoopCorrection); at a frame boundary the map takes the solution. Fixed memory.
 #include <cstdint>
 #include <span>
 #include <vector>
 
+#include "mcslam/core/background_task.hpp"
 #include "mcslam/places/loop_correction.hpp"
 #include "mcslam/places/place_map.hpp"
 #include "mcslam/places/places_options.hpp"
@@ -23,10 +26,12 @@ struct LoopStats {
   uint64_t closures = 0;    // accepted: the map was corrected
   uint64_t merges = 0;      // closures that joined two segments
   uint64_t skipped = 0;     // keyframes not queried: a correction was being solved
+  uint64_t waits = 0;       // frames that had to wait for a detection to finish before writing the map
   uint64_t restarted = 0;   // corrections solved again: a segment was moved or rescaled during the solve
   int64_t last_keyframe = -1, last_candidate = -1;  // place keyframe ids of the last closure
   double last_correction_m = 0, last_correction_deg = 0;
   double last_solve_ms = 0;
+  double last_detection_ms = 0;  // the last keyframe's query and verification, on the detection thread
 };
 
 // The map file's loops part: the loops, then each of the map's segments' root (which segment the loops joined it
@@ -40,22 +45,32 @@ class LoopCloser {
  public:
   LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera);
 
+  // The extrinsics the next detection projects with. Not while detecting().
   void setRig(const Rig& rig) { verifier_.setRig(rig); }
-  // Keyframe `slot` (just added, with the frame it was made of and its words): true when it closed a loop, whose
-  // correction is then being solved; the map does not move until takeCorrection().
-  bool onKeyframe(int slot, const FrameFeatures& features, const FrameWords& words, PlaceMap& map,
-                  const PlaceDatabase& database);
+  // Keyframe `slot` was just added to `map`, with its words to `database` (`features`: the frame it was made of):
+  // starts looking for a loop it closes on the detection thread (copying `features` and `words`). Until
+  // collectDetection() took the result, `map` and `database` must not be written. Not while detecting().
+  void startDetection(int slot, const FrameFeatures& features, const FrameWords& words, const PlaceMap& map,
+                      const PlaceDatabase& database);
+  bool detecting() const { return detection_task_.running(); }
+  // Takes the result of the detection in flight, waiting for it with `wait` (otherwise only when it is ready), and
+  // decides on it: true when it closed a loop, whose correction is then being solved; the map does not move until
+  // takeCorrection(). `map` is the one the detection started on, unchanged.
+  bool collectDetection(const PlaceMap& map, bool wait);
   // At a frame boundary: a correction solved since moves the map's keyframes and segments' frames (true). With
   // `wait`, one in flight is waited for; without, it is taken at the first call that finds it ready.
   bool takeCorrection(PlaceMap& map, bool wait);
   bool correcting() const { return correction_.running() || correction_wanted_; }
-  uint64_t threadAllocations() const { return correction_.threadAllocations(); }
+  // By the detection and correction threads; any thread may ask.
+  uint64_t threadAllocations() const { return correction_.threadAllocations() + detection_task_.allocations(); }
   const LoopStats& stats() const { return stats_; }
   int loops() const { return loop_count_; }
   std::span<const LoopEdge> loopEdges() const { return {loops_.data(), static_cast<std::size_t>(loop_count_)}; }
-  void clear();
+  void clear();  // waits for a detection in flight and drops it
   // The segment that stands for all those loops have joined to `segment`.
   int32_t root(int32_t segment) { return findRoot(segment); }
+  // No loop joined `segment` to another (it may be reused for a new one).
+  bool alone(int32_t segment);
 
   // The map file's part: the loops and which segments they joined. read() replaces them (InputError from `in` for
   // a file that does not fit max_loops or the map's `segments`).
@@ -64,6 +79,15 @@ class LoopCloser {
   std::size_t maxWrittenBytes() const;
 
  private:
+  // The job of the detection thread: the query and verification of the keyframe being detected.
+  struct Detection final : BackgroundJob {
+    void run() override { closer->detect(); }
+    LoopCloser* closer = nullptr;
+  };
+
+  void detect();
+  // What the detection found for keyframe `slot` decides whether it closes a loop (onto the processing thread).
+  bool decide(int slot, const RelocalizationResult& found, const PlaceMap& map);
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
   bool closesALoop(const PlaceMap& map, int candidate, int slot) const;
   // Starts solving the pose graph of the whole map with the loops so far (LoopCorrection).
@@ -91,6 +115,16 @@ class LoopCloser {
   int64_t pending_candidate_ = -1;
   SE3 pending_correction_;
   LoopStats stats_;
+  // The detection in flight: its keyframe, the map and database it reads, copies of the keyframe's frame and words,
+  // and what it found.
+  int detect_slot_ = -1;
+  const PlaceMap* detect_map_ = nullptr;
+  const PlaceDatabase* detect_database_ = nullptr;
+  FrameFeatures detect_features_;
+  FrameWords detect_words_;
+  RelocalizationResult found_;
+  Detection detection_;
+  BackgroundTask detection_task_;  // last: stops (after the job in flight) before what the job uses goes
 };
 
 }  // namespace mcslam

@@ -52,6 +52,7 @@ class LoopCorrection {
   };
 
   void apply(PlaceMap& map);
+  int newestNode(int32_t segment) const;  // the segment's newest keyframe in the graph being solved, or -1
   void addLoops(std::span<const LoopEdge> loops, int nodes);
   int nodeOfId(int64_t id, int nodes) const;  // -1 when no node has it (the keyframe was let go)
 

@@ -84,6 +84,10 @@ class PlaceMap {
   // `continues`: the segment whose frame this one's continues (the odometry coasted from it), -1 for none; kept in
   // memory only, for a loop correction that lands after the new segment began (LoopCloser).
   int32_t createSegment(const SE3& T_w_o, bool placed = true, int32_t continues = -1);  // -1 when kMaxSegments
+  // With every segment taken, one that holds no keyframe is made anew (as createSegment would make it); segments
+  // that continued it no longer continue anything.
+  void reuseSegment(int32_t segment, const SE3& T_w_o, bool placed, int32_t continues);
+  bool hasKeyframes(int32_t segment) const { return newest_of_segment_[static_cast<std::size_t>(segment)] >= 0; }
   int32_t continuesFrom(int32_t segment) const { return segment_continues_[static_cast<std::size_t>(segment)]; }
   int segments() const { return segment_count_; }
   const SE3& segmentPose(int32_t segment) const { return segment_T_w_o_[static_cast<std::size_t>(segment)]; }
@@ -125,6 +129,7 @@ class PlaceMap {
   mutable std::vector<int32_t> file_position_;  // scratch of write() and read(), one per slot
 
   void checkChains(const ByteReader& in);
+  void setUpSegment(int32_t segment, const SE3& T_w_o, bool placed, int32_t continues);
   int segment_count_ = 0;
 };
 

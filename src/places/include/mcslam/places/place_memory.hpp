@@ -34,6 +34,7 @@ struct PlaceStats {
   int64_t last_relocalized_frame = -1;     // frame index of the last relocalization
   int64_t placed_frame = -1;               // with a reused map: the frame first recognized in it
   uint64_t localization_corrections = 0;   // localizing in a map: recognitions that moved the estimate
+  uint64_t segments_reused = 0;            // all PlaceMap::kMaxSegments taken: an empty one made anew
 };
 
 class PlaceMemory {
@@ -44,9 +45,13 @@ class PlaceMemory {
 
   // After odometry.process(frame, frame_index, out): see above. `out` ends in the world frame.
   void afterOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);
-  // Takes a loop correction still being solved into the map (after the last frame, before reading the map).
-  void flush() { takeCorrection(/*wait=*/true); }
-  uint64_t threadAllocations() const { return loop_closer_.threadAllocations(); }  // by the loop closer's thread
+  // Takes the loop closer's work still in flight (a detection, then a correction) into the map (after the last
+  // frame, before reading the map).
+  void flush() {
+    collectLoopDetection(/*wait=*/true);
+    takeCorrection(/*wait=*/true);
+  }
+  uint64_t threadAllocations() const { return loop_closer_.threadAllocations(); }  // by the loop closer's threads
 
   const PlaceMap& map() const { return map_; }
   const PlaceStats& stats() const { return stats_; }
@@ -67,9 +72,14 @@ class PlaceMemory {
   bool mapLoaded() const { return loaded_; }
 
  private:
-  // A loop correction solved since the last frame moves the map (PlacesOptions::wait_for_correction: waiting for it).
+  // A loop correction solved since the last frame moves the map (PlacesOptions::repeatable: waiting for it).
   void takeCorrection(bool wait);
+  // This frame (the odometry's output) writes neither the place map nor the database: it only tracked, in a placed
+  // segment, and settled, rescaled and began nothing.
+  bool onlyReadsMap(const Odometry& odometry, const PoseEstimate& out) const;
+  void collectLoopDetection(bool wait);
   void followSegment(const Odometry& odometry);
+  int32_t reuseSegment(const SE3& T_w_o, bool placed);  // -1 when none can be
   void addKeyframe(const Odometry& odometry, int odometry_slot);
   void makeRoom();  // a full map lets its least needed keyframe go, keeping those loops join
   void relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);

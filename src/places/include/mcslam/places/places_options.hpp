@@ -40,10 +40,12 @@ struct PlacesOptions {
   // its uncertainty changes nothing.
   double loop_sigma_translation = 0.02;
   double loop_sigma_rotation_deg = 0.5;
-  // A loop's correction is solved on its own thread while the next frame is processed. true: the next frame waits
-  // for it, so that runs repeat exactly (mcslam-run); false: the first frame that finds it ready takes it, and no
-  // frame ever waits (mcslamd, a live rig). Set by the program, not by the configuration file.
-  bool wait_for_correction = true;
+  // The loop closer works on threads of its own: the detection on each keyframe, the correction after a loop.
+  // true: the frame waits for them at fixed points (a detection within its keyframe's frame, a correction at the
+  // next frame), so that runs repeat exactly (mcslam-run); false: the first frame that finds a result ready takes it,
+  // and a frame waits only for a detection whose map it must write (mcslamd, a live rig). Set by the program, not by
+  // the configuration file.
+  bool repeatable = true;
 
   // Localizing in a saved map (PlaceMemory::readMap), a recognition corrects the odometry only by what it can have
   // drifted since the last correction: this floor plus this share of the path (and likewise in angle). Visual odometry
