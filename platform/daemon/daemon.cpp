@@ -178,6 +178,7 @@ DaemonStats Daemon::stats() const {
   s.trajectory_poses = publishing_.trajectory().written();
   s.trajectory_errors = publishing_.trajectory().errors();
   s.trajectory_reopened = publishing_.trajectory().reopened();
+  s.shm_replacements = publishing_.shmReplacements();
   s.trajectory_errno = publishing_.trajectory().lastErrno();
   s.tracking = processing_.tracking();
   s.unscaled = processing_.unscaled();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 
 #include "daemon/config_names.hpp"
@@ -13,6 +14,7 @@
 #include "mcslam/pipeline/pipeline_factory.hpp"
 #include "mcslam/sim/rig_presets.hpp"
 #include "mcslam/sim/world.hpp"
+#include "realtime/scheduling.hpp"
 #include "shm/pose_shm_writer.hpp"
 #include "udp/udp_pose_sender.hpp"
 
@@ -26,18 +28,24 @@ std::string resolvePath(const std::string& file, const std::string& path) {
   return (dir.empty() ? std::filesystem::path(path) : dir / path).lexically_normal().string();
 }
 
-std::vector<int> readCameraList(const YamlFields& f) {
-  std::vector<int> cameras;
-  if (!f.has("cameras")) return cameras;
-  const YAML::Node n = f.node("cameras");
-  if (!n.IsSequence()) f.fail("cameras", "expected a list of calibration indices");
+// A list of small non-negative integers under `key` (empty when absent): `what` says what each item is.
+std::vector<int> readIndexList(const YamlFields& f, const char* key, const std::string& what, int max) {
+  std::vector<int> list;
+  if (!f.has(key)) return list;
+  const YAML::Node n = f.node(key);
+  if (!n.IsSequence()) f.fail(key, "expected a list of " + what + (what.back() == 'x' ? "es" : "s"));
   for (std::size_t i = 0; i < n.size(); ++i) {
     int v = 0;
-    if (!n[i].IsScalar() || !YAML::convert<int>::decode(n[i], v) || v < 0)
-      f.fail("cameras", "item " + std::to_string(i) + " must be a camera index >= 0");
-    cameras.push_back(v);
+    if (!n[i].IsScalar() || !YAML::convert<int>::decode(n[i], v) || v < 0 || v > max)
+      f.fail(key, "item " + std::to_string(i) + " must be a " + what +
+                      (max == std::numeric_limits<int>::max() ? " >= 0" : " from 0 to " + std::to_string(max)));
+    list.push_back(v);
   }
-  return cameras;
+  return list;
+}
+
+std::vector<int> readCameraList(const YamlFields& f) {
+  return readIndexList(f, "cameras", "camera index", std::numeric_limits<int>::max());
 }
 
 void readSim(const YamlFields& f, SimSourceConfig& s) {
@@ -191,11 +199,12 @@ void readMap(const YamlFields& m, MapConfig& c) {
 }
 
 void readRealtime(const YamlFields& rt, RealtimeConfig& r) {
-  rt.allowOnly({"trigger_priority", "acquisition_priority", "processing_priority", "lock_memory"});
+  rt.allowOnly({"trigger_priority", "acquisition_priority", "processing_priority", "lock_memory", "cpus"});
   r.trigger_priority = static_cast<int>(rt.integer("trigger_priority", 0, 0, 99));
   r.acquisition_priority = static_cast<int>(rt.integer("acquisition_priority", 0, 0, 99));
   r.processing_priority = static_cast<int>(rt.integer("processing_priority", 0, 0, 99));
   r.lock_memory = rt.boolean("lock_memory", false);
+  r.cpus = readIndexList(rt, "cpus", "CPU number", kMaxCpuNumber);
 }
 
 // The rig: the calibration file, or the dataset's own (possibly overridden by `calibration`), or the simulated one.

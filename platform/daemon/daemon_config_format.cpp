@@ -108,7 +108,8 @@ void emitOutputs(YAML::Emitter& e, const DaemonConfig& c) {
   e << YAML::Key << "trigger_priority" << YAML::Value << r.trigger_priority;
   e << YAML::Key << "acquisition_priority" << YAML::Value << r.acquisition_priority;
   e << YAML::Key << "processing_priority" << YAML::Value << r.processing_priority;
-  e << YAML::Key << "lock_memory" << YAML::Value << r.lock_memory << YAML::EndMap;
+  e << YAML::Key << "lock_memory" << YAML::Value << r.lock_memory;
+  e << YAML::Key << "cpus" << YAML::Value << YAML::Flow << r.cpus << YAML::EndMap;
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "daemon/daemon.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
+#include "realtime/scheduling.hpp"
 #include "systemd/notifier.hpp"
 
 namespace mcslam::platform {
@@ -36,6 +37,11 @@ void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char
       static_cast<unsigned long long>(s.places.loop_closures), static_cast<unsigned long long>(s.places.map_merges),
       static_cast<unsigned>(s.places.world_revision), static_cast<unsigned long long>(s.map_saves),
       static_cast<unsigned long long>(s.map_save_failures));
+  if (s.shm_replacements == 0) return;
+  const std::size_t used = std::strlen(out);
+  if (used + 1 < size)
+    std::snprintf(out + used, size - used, ", shm segments made anew %llu",
+                  static_cast<unsigned long long>(s.shm_replacements));
 }
 
 namespace {
@@ -230,6 +236,16 @@ int superviseUntilStop(const DaemonConfig& config, const Daemon& daemon, Systemd
   }
 }
 
+void restrictCpus(const std::vector<int>& cpus) {
+  if (cpus.empty()) return;
+  std::string list;
+  for (const int cpu : cpus) list += (list.empty() ? "" : ", ") + std::to_string(cpu);
+  if (const std::string why = restrictToCpus(cpus); !why.empty())
+    spdlog::warn("realtime.cpus [{}]: {}; the threads run on any CPU", list, why);
+  else
+    spdlog::info("realtime: every thread on CPUs {}", list);
+}
+
 }  // namespace
 
 int runDaemon(const DaemonConfig& config) {
@@ -238,6 +254,7 @@ int runDaemon(const DaemonConfig& config) {
   const sigset_t signals = handledSignals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
+  restrictCpus(config.realtime.cpus);  // before the pipeline's and the daemon's threads, which inherit it
   SystemdNotifier notifier;
   Daemon daemon(config, createPipeline(config.slam, config.file, config.rig, /*live=*/true));
   daemon.start();
@@ -260,6 +277,8 @@ int runDaemon(const DaemonConfig& config) {
       static_cast<double>(s.latency_p99_ns) * 1e-6, s.allocations_after_warmup, s.frames_after_warmup,
       alloc::totalCount());
   if (!clean) spdlog::error("the pipeline did not finish its frame within the grace period");
+  if (s.shm_replacements > 0)
+    spdlog::warn("publish.shm: segments made anew after a truncation by another process: {}", s.shm_replacements);
   if (s.trajectory_errors > 0)
     spdlog::error("trajectory {}: {} poses or syncs failed (last: {}); the file holds whole lines only",
                   daemon.trajectoryPath(), s.trajectory_errors, std::strerror(s.trajectory_errno));

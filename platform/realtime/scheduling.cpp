@@ -38,4 +38,13 @@ std::string pinThisThread(int cpu) {
   return rc == 0 ? std::string() : "CPU " + std::to_string(cpu) + ": " + std::strerror(rc);
 }
 
+std::string restrictToCpus(const std::vector<int>& cpus) {
+  if (cpus.empty()) return {};
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (const int cpu : cpus) CPU_SET(cpu, &set);
+  const int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+  return rc == 0 ? std::string() : std::strerror(rc);
+}
+
 }  // namespace mcslam::platform

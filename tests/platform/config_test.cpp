@@ -72,6 +72,8 @@ TEST_F(ConfigTest, WrongTypesNameTheKeyAndTheValue) {
   expectError(replay("trigger:\n  rate_hz: [1, 2]\n"), {"trigger.rate_hz", "a list"});
   expectError(replay("publish:\n  udp:\n    destinations: 127.0.0.1:9000\n"), {"publish.udp.destinations", "list"});
   expectError(replay("realtime:\n  lock_memory: maybe\n"), {"realtime.lock_memory", "'maybe'"});
+  expectError(replay("realtime:\n  cpus: [0, 1024]\n"), {"realtime.cpus", "item 1", "CPU number from 0 to 1023"});
+  expectError(replay("realtime:\n  cpus: 2\n"), {"realtime.cpus", "list of CPU numbers"});
   expectError(replay("publish:\n  shm:\n    mode: \"0999\"\n"), {"publish.shm.mode", "0999"});
   expectError(replay("trigger:\n  mode: laser\n"), {"trigger.mode", "'laser'"});
 }

@@ -357,3 +357,14 @@ TEST(DaemonStatus, TheStatusLineSaysWhenPositionsAreUpToScale) {
   formatStatus(s, 10.0, "ok", line, sizeof(line));
   EXPECT_NE(std::string(line).find("tracking (up to scale)"), std::string::npos) << line;
 }
+
+// A pose segment made anew (another process truncated it) is in the status line, and only then.
+TEST(DaemonStatus, TheStatusLineCountsSegmentsMadeAnew) {
+  DaemonStats s;
+  char line[400];
+  formatStatus(s, 10.0, "ok", line, sizeof(line));
+  EXPECT_EQ(std::string(line).find("shm segments"), std::string::npos) << line;
+  s.shm_replacements = 2;
+  formatStatus(s, 10.0, "ok", line, sizeof(line));
+  EXPECT_NE(std::string(line).find(", shm segments made anew 2"), std::string::npos) << line;
+}

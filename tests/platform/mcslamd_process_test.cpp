@@ -17,10 +17,13 @@
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "daemon_fixture.hpp"
 #include "mcslam/calib/calibration_io.hpp"
@@ -360,6 +363,47 @@ TEST(McslamdProcess, OtherSignalsAreAnsweredAndSigquitStopsCleanly) {
   EXPECT_NE(log.find("SIGQUIT: stopping"), std::string::npos) << log;
   EXPECT_NE(log.find("stopped:"), std::string::npos) << log;
   EXPECT_EQ(notify.count("STOPPING=1"), 1);
+}
+
+// The CPUs each of the process's threads may run on (/proc/PID/task/*/status, Cpus_allowed_list), one per thread.
+std::vector<std::string> threadCpuLists(pid_t pid) {
+  std::vector<std::string> lists;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task")) {
+    const std::string status = readAll(task.path().string() + "/status");
+    const std::size_t at = status.find("Cpus_allowed_list:");
+    if (at == std::string::npos) continue;
+    const std::size_t begin = status.find_first_not_of(" \t", at + 18);
+    lists.push_back(status.substr(begin, status.find('\n', begin) - begin));
+  }
+  return lists;
+}
+
+// realtime.cpus keeps every thread of the daemon (the pipeline's workers and background tasks included) on the
+// CPUs it names; a set the machine cannot honour is a warning, and the daemon runs on any CPU.
+TEST(McslamdProcess, RealtimeCpusKeepsEveryThreadOnThem) {
+  test::TempDir dir("mcslamd-cpus");
+  NotifyListener notify(dir.file("notify.sock"));
+  ASSERT_TRUE(notify.ok());
+  const std::string idle = test::readFile(idleDaemonConfig(dir, "1000"));
+  for (const auto& [cpus, expected] : {std::pair<std::string, std::string>{"[0]", "0"}, {"[1023]", ""}}) {
+    const std::string config = test::writeFile(dir.file("cpus.yaml"), idle + "realtime:\n  cpus: " + cpus + "\n");
+    const int ready_before = notify.count("READY=1");
+    const pid_t pid = spawnDaemon(config, dir.file("notify.sock"), "0", dir.file("log.txt"));
+    const ReapOnExit reap_pid(pid);
+    ASSERT_TRUE(waitFor([&] { return notify.count("READY=1") > ready_before; })) << readAll(dir.file("log.txt"));
+    const std::vector<std::string> lists = threadCpuLists(pid);
+    EXPECT_GE(lists.size(), 5u);  // main, trigger, assembly, processing stages, workers
+    const std::string log = readAll(dir.file("log.txt"));
+    if (expected.empty()) {  // CPU 1023 is on no machine this runs on
+      EXPECT_NE(log.find("realtime.cpus [1023]: Invalid argument; the threads run on any CPU"), std::string::npos)
+          << log;
+    } else {
+      EXPECT_NE(log.find("realtime: every thread on CPUs 0"), std::string::npos) << log;
+      for (const std::string& list : lists) EXPECT_EQ(list, expected);
+    }
+    ::kill(pid, SIGTERM);
+    EXPECT_EQ(waitExit(pid, 20), 0) << log;
+  }
 }
 
 TEST(McslamdProcess, ImageCodecIsMappedOnlyWhenTheReplayMeetsAPng) {

@@ -98,6 +98,9 @@ TEST(ShmRestart, ADaemonWhoseSegmentIsTruncatedGoesOnInANewOne) {
   EXPECT_NE(logsOf(dir, "daemon").find("was truncated by another process"), std::string::npos) << logsOf(dir, "daemon");
   ASSERT_TRUE(daemon->signal(SIGTERM));
   EXPECT_EQ(daemon->wait(), 0) << logsOf(dir, "daemon");
+  EXPECT_NE(logsOf(dir, "daemon").find("segments made anew after a truncation by another process: 1"),
+            std::string::npos)
+      << logsOf(dir, "daemon");
 }
 
 // A second daemon must not unlink the first one's live segment, nor the first one's stop the second one's.

@@ -34,6 +34,7 @@ struct DaemonStats {
   uint64_t rig_frames = 0, partial_frames = 0, late_images = 0, rig_drops = 0;
   uint64_t processed = 0, published = 0, pose_drops = 0;
   uint64_t udp_sent = 0, udp_failed = 0, trajectory_poses = 0, trajectory_errors = 0, trajectory_reopened = 0;
+  uint64_t shm_replacements = 0;            // the pose segment was truncated by another process and made anew
   int trajectory_errno = 0, udp_errno = 0;  // the reasons of the last failed trajectory write and UDP send
   TrackingState tracking = TrackingState::NotInitialized;
   bool unscaled = false;  // the last pose's position is not in metres (PoseEstimate::metric)

@@ -57,6 +57,7 @@ struct RealtimeConfig {
   int acquisition_priority = 0;
   int processing_priority = 0;
   bool lock_memory = false;
+  std::vector<int> cpus;  // the CPUs every thread of the daemon may run on (empty: any)
 };
 
 struct DaemonConfig {

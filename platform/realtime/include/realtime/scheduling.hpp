@@ -1,6 +1,7 @@
 #pragma once
 // Thread names, realtime scheduling and memory locking (all optional, from the `realtime:` config).
 #include <string>
+#include <vector>
 
 namespace mcslam::platform {
 
@@ -16,5 +17,12 @@ std::string lockAllMemory();
 
 // Pins the calling thread to one CPU (-1 = no pinning). Empty string on success.
 std::string pinThisThread(int cpu);
+
+// The highest CPU number an affinity set can name (CPU_SETSIZE - 1).
+inline constexpr int kMaxCpuNumber = 1023;
+
+// Lets the calling thread, and every thread it creates from now on, run only on `cpus` (0..kMaxCpuNumber; empty:
+// no change). Empty string on success, else the reason (e.g. none of them is online).
+std::string restrictToCpus(const std::vector<int>& cpus);
 
 }  // namespace mcslam::platform
