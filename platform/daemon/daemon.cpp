@@ -185,6 +185,13 @@ DaemonStats Daemon::stats() const {
   s.latency_count = publishing_.latency().count();
   s.latency_p50_ns = publishing_.latency().percentileNs(0.5);
   s.latency_p99_ns = publishing_.latency().percentileNs(0.99);
+  const auto percentiles = [](const LatencyHistogram& h) {
+    return DaemonStats::StageTime{h.percentileNs(0.5), h.percentileNs(0.99)};
+  };
+  const StageTimes& t = processing_.stageTimes();
+  s.front_end_time = percentiles(t.front_end);
+  s.odometry_time = percentiles(t.odometry);
+  s.place_memory_time = percentiles(t.place_memory);
   s.warm = warm_up_.warm();
   if (s.warm) {
     s.frames_after_warmup = s.processed - warm_up_.countAtEnd();

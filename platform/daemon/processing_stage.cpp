@@ -120,7 +120,17 @@ void ProcessingStage::afterFrame() {
     place_keyframes_.store(c.keyframes, std::memory_order_relaxed);
     world_revision_.store(c.world_revision, std::memory_order_relaxed);
   }
+  recordStageTimes();
   if (map_saver_) map_saver_->afterFrame(processor_, monotonicNowNs());
+}
+
+void ProcessingStage::recordStageTimes() {
+  const PipelineTiming* t = processor_.lastTiming();
+  if (!t) return;
+  const auto ns = [](double ms) { return static_cast<int64_t>(ms * 1e6); };
+  stage_times_.front_end.record(ns(t->features_ms));
+  stage_times_.odometry.record(ns(t->tracking_ms + t->optimization_ms));
+  stage_times_.place_memory.record(ns(t->places_ms));
 }
 
 PlaceCounters ProcessingStage::placeCounters() const {

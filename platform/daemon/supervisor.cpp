@@ -276,6 +276,12 @@ int runDaemon(const DaemonConfig& config) {
       s.partial_frames, s.bad_frames, static_cast<double>(s.latency_p50_ns) * 1e-6,
       static_cast<double>(s.latency_p99_ns) * 1e-6, s.allocations_after_warmup, s.frames_after_warmup,
       alloc::totalCount());
+  const auto ms = [](int64_t ns) { return static_cast<double>(ns) * 1e-6; };
+  spdlog::info(
+      "stage times per frame, p50 / p99: front-end {:.1f} / {:.1f} ms, odometry {:.1f} / {:.1f} ms, place "
+      "memory {:.1f} / {:.1f} ms",
+      ms(s.front_end_time.p50_ns), ms(s.front_end_time.p99_ns), ms(s.odometry_time.p50_ns), ms(s.odometry_time.p99_ns),
+      ms(s.place_memory_time.p50_ns), ms(s.place_memory_time.p99_ns));
   if (!clean) spdlog::error("the pipeline did not finish its frame within the grace period");
   if (s.shm_replacements > 0)
     spdlog::warn("publish.shm: segments made anew after a truncation by another process: {}", s.shm_replacements);

@@ -12,6 +12,7 @@
 #include <map>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include "alloc_testing.hpp"
 #include "daemon/daemon.hpp"
@@ -45,9 +46,12 @@ class FakeProcessor : public FrameProcessor {
     out.is_keyframe = f.sequence % 5 == 0;
     out.metric = f.sequence >= 20;  // as a rig without overlap before its scale converged
   }
+  // Stage times as a pipeline reports them: odometry 4 ms (3 + 1), front-end 2 ms, place memory 0.5 ms.
+  const PipelineTiming* lastTiming() const override { return &timing_; }
 
  private:
   int delay_ms_;
+  PipelineTiming timing_{2.0, 3.0, 1.0, 0.5, 6.5};
 };
 
 // FNV-1a of an image's pixels.
@@ -247,6 +251,12 @@ TEST_F(DaemonTest, SoftwareTriggerDrivesTheReplayAndLatencyIsMeasured) {
   EXPECT_GE(s.latency_count, 20u);
   EXPECT_GT(s.latency_p50_ns, 0);
   EXPECT_LE(s.rig_frames, s.triggers);  // one frame per trigger at most
+  // The processor's stage times, to the histogram's 2% bins.
+  for (const auto& [time, ms] :
+       {std::pair{s.front_end_time, 2.0}, {s.odometry_time, 4.0}, {s.place_memory_time, 0.5}}) {
+    EXPECT_NEAR(static_cast<double>(time.p50_ns) * 1e-6, ms, 0.03 * ms);
+    EXPECT_NEAR(static_cast<double>(time.p99_ns) * 1e-6, ms, 0.03 * ms);
+  }
 }
 
 TEST_F(DaemonTest, NoDaemonThreadAllocatesPerFrameAfterWarmup) {
@@ -297,7 +307,7 @@ TEST_F(DaemonTest, PlaceMemoryAndMapSavesAllocateNothingPerFrameAfterWarmup) {
                                 "    rate: fastest\n    at_end: loop\n    preload: true\nwarmup_frames: 100\n"
                                 "map:\n  save: " +
                                     dir_.file("robot.map") + "\n  save_interval_s: 0.2\n");
-  Daemon d(c, createPipeline(c.slam, c.file, c.rig));
+  Daemon d(c, createPipeline(c.slam, c.file, c.rig, /*live=*/true));  // as mcslamd runs it
   d.start();
   ASSERT_TRUE(waitFor([&] { return d.stats().processed >= 300 && d.stats().map_saves >= 3; }, 300));
   d.stop();

@@ -40,6 +40,10 @@ struct DaemonStats {
   bool unscaled = false;  // the last pose's position is not in metres (PoseEstimate::metric)
   uint64_t latency_count = 0;
   int64_t latency_p50_ns = 0, latency_p99_ns = 0;  // trigger -> published
+  struct StageTime {
+    int64_t p50_ns = 0, p99_ns = 0;
+  };
+  StageTime front_end_time, odometry_time, place_memory_time;  // per frame (ProcessingStage::stageTimes)
   bool warm = false;
   uint64_t frames_after_warmup = 0, allocations_after_warmup = 0;  // our threads
   bool source_finished = false;

@@ -12,10 +12,18 @@
 #include "daemon/map_saver.hpp"
 #include "mcslam/pipeline/stage_runner.hpp"
 #include "realtime/alloc_meter.hpp"
+#include "realtime/latency_histogram.hpp"
 #include "realtime/warm_up.hpp"
 #include "sources/back_pressure.hpp"
 
 namespace mcslam::platform {
+
+// Each processed frame's time in the pipeline's stages (FrameProcessor::lastTiming); any thread may read them.
+struct StageTimes {
+  LatencyHistogram front_end;     // features: ORB and multi-view
+  LatencyHistogram odometry;      // tracking, mapping and the wait for the window solve
+  LatencyHistogram place_memory;  // its share of the processing thread
+};
 
 class ProcessingStage {
  public:
@@ -41,6 +49,7 @@ class ProcessingStage {
   }
   // As of the last frame processed (zeros for a processor without place memory).
   PlaceCounters placeCounters() const;
+  const StageTimes& stageTimes() const { return stage_times_; }
 
  private:
   // What the daemon needs to know again about a frame once it is processed.
@@ -55,7 +64,8 @@ class ProcessingStage {
   RigFrameView viewOf(const RigFrame& f);
   void handOver(PoseSlot& out, const FrameTag& tag);
 
-  void afterFrame();  // place counters, map saving
+  void afterFrame();  // place counters, stage times, map saving
+  void recordStageTimes();
 
   FrameProcessor& processor_;
   MapSaver* map_saver_;
@@ -77,6 +87,7 @@ class ProcessingStage {
   std::atomic<uint16_t> world_revision_{0};
   ThreadAllocMeter features_meter_, processing_meter_;
   ThreadAllocMeter background_meter_;  // the processor's own threads, read after each frame
+  StageTimes stage_times_;
 };
 
 }  // namespace mcslam::platform

@@ -23,6 +23,15 @@ struct RigFrameView {
   const bool* present = nullptr;
 };
 
+// Milliseconds spent on the last frame, by stage (the paper's Table III split).
+struct PipelineTiming {
+  double features_ms = 0;      // ORB extraction and multi-view features
+  double tracking_ms = 0;      // pose estimation, keyframe decision, new landmarks
+  double optimization_ms = 0;  // sliding-window back-end
+  double places_ms = 0;        // place memory on the processing thread (relocalization, keyframes, loops)
+  double total_ms = 0;
+};
+
 // What place memory has done so far, for a daemon's status.
 struct PlaceCounters {
   uint64_t relocalizations = 0;
@@ -79,6 +88,9 @@ class FrameProcessor {
   // Heap allocations made so far by the processor's own threads beyond prepare()'s and finish()'s (a back-end
   // solver's, say); any thread may ask, at any time.
   virtual uint64_t backgroundThreadAllocations() const { return 0; }
+  // The stage times of the last finished frame, read on the finishing thread between frames; nullptr for a
+  // processor that does not time its stages.
+  virtual const PipelineTiming* lastTiming() const { return nullptr; }
 };
 
 inline void FrameProcessor::loadMap(const std::string& path, bool localize_only) {

@@ -9,15 +9,6 @@
 
 namespace mcslam {
 
-// Milliseconds spent on the last frame, by stage (the paper's Table III split).
-struct PipelineTiming {
-  double features_ms = 0;      // ORB extraction and multi-view features
-  double tracking_ms = 0;      // pose estimation, keyframe decision, new landmarks
-  double optimization_ms = 0;  // sliding-window back-end
-  double places_ms = 0;        // place memory on the processing thread (relocalization, keyframes, loops)
-  double total_ms = 0;
-};
-
 // A keyframe of the map with its latest optimized pose.
 struct KeyframePose {
   int64_t id = -1;
@@ -43,6 +34,7 @@ class SlamPipeline final : public FrameProcessor {
 
   // Read on the thread that finishes the frames, between frames.
   const PipelineTiming& timing() const { return timing_; }  // of the last finished frame
+  const PipelineTiming* lastTiming() const override { return &timing_; }
   const OdometryStats& stats() const { return odometry_.stats(); }
   // Place memory; nullptr when the configuration turns it off.
   const PlaceMemory* places() const { return places_.get(); }
