@@ -68,6 +68,7 @@ RigFrameView ProcessingStage::viewOf(const RigFrame& f) {
 void ProcessingStage::wholeLoop() {
   FrameTag tag;
   while (RigFrame* f = in_.next(stop_)) {
+    taken_.fetch_add(1, std::memory_order_relaxed);
     runner_.prepare(viewOf(*f), FrameTag{f->trigger_mono_ns, f->presentCount()});
     in_.release();
     PoseSlot& out = out_.slot();
@@ -80,6 +81,7 @@ void ProcessingStage::featuresLoop() {
   // prepare() waits for a free slot (tracking finishes them in order); meanwhile new rig frames queue, and the
   // oldest is dropped when the rig ring is full, as without stages.
   while (RigFrame* f = in_.next(stop_)) {
+    taken_.fetch_add(1, std::memory_order_relaxed);
     runner_.prepare(viewOf(*f), FrameTag{f->trigger_mono_ns, f->presentCount()});
     in_.release();
     features_meter_.note(warm_up_.warm());

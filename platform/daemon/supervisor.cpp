@@ -79,14 +79,15 @@ class Watch {
         last_progress_(monotonicNowNs()),
         last_status_(last_progress_) {}
 
-  // One tick: the watchdog (only when frames were processed since the last tick, or a finished replay idles),
+  // One tick: the watchdog (only when frames were processed since the last tick, or a finished replay has
+  // processed all it delivered and idles),
   // state changes, and the status line every status interval.
   void tick(const Daemon& daemon, SystemdNotifier& notifier) {
     const int64_t now = monotonicNowNs();
     const DaemonStats s = daemon.stats();
     char health[128];
     daemon.health(health, sizeof(health));
-    watchdog(s, now, health, notifier);
+    watchdog(s, daemon.drained(), now, health, notifier);
     logChanges(s, health);
     logOutputs(s);
     if (now - last_status_ >= status_ns_) status(s, health, now, notifier);
@@ -110,17 +111,19 @@ class Watch {
     last_status_ = now;
   }
 
-  void watchdog(const DaemonStats& s, int64_t now, const char* health, SystemdNotifier& notifier) {
+  // A replay that ended is idle only once its frames are processed: until then a hung pipeline must not be pinged.
+  void watchdog(const DaemonStats& s, bool drained, int64_t now, const char* health, SystemdNotifier& notifier) {
     const bool progress = s.processed > last_processed_;
+    const bool idle = s.source_finished && drained;
     if (progress) {
       last_progress_ = now;
       if (stall_reported_) spdlog::info("frames flow again");
       stall_reported_ = false;
-    } else if (!s.source_finished && now - last_progress_ > 2000000000 && !stall_reported_) {
+    } else if (!idle && now - last_progress_ > 2000000000 && !stall_reported_) {
       spdlog::warn("no frame processed for 2 s (cameras: {})", health);
       stall_reported_ = true;
     }
-    if (progress || s.source_finished) notifier.watchdog();
+    if (progress || idle) notifier.watchdog();
     last_processed_ = s.processed;
   }
 
@@ -248,7 +251,7 @@ void restrictCpus(const std::vector<int>& cpus) {
 
 }  // namespace
 
-int runDaemon(const DaemonConfig& config) {
+int runDaemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> processor) {
   // Block the signals before any thread exists, so every thread inherits the mask and only this one receives
   // them (sigtimedwait).
   const sigset_t signals = handledSignals();
@@ -256,7 +259,8 @@ int runDaemon(const DaemonConfig& config) {
 
   restrictCpus(config.realtime.cpus);  // before the pipeline's and the daemon's threads, which inherit it
   SystemdNotifier notifier;
-  Daemon daemon(config, createPipeline(config.slam, config.file, config.rig, /*live=*/true));
+  if (!processor) processor = createPipeline(config.slam, config.file, config.rig, /*live=*/true);
+  Daemon daemon(config, std::move(processor));
   daemon.start();
   notifier.ready();
   spdlog::info("mcslamd: running ({} cameras, source {}, trigger {}, trajectory {}){}", config.rig.size(),

@@ -19,12 +19,18 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <thread>
 #include <utility>
 #include <vector>
 
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include "daemon/supervisor.hpp"
 #include "daemon_fixture.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/dataset/trajectory.hpp"
@@ -339,6 +345,75 @@ TEST(McslamdProcess, NoWatchdogWhileNoFrameIsProcessed) {
 
 // Signals other than the stopping ones neither kill the daemon (their default action) nor stop it; SIGQUIT stops it
 // as SIGTERM does, through the clean stop.
+namespace {
+// The log lines of the daemon's threads while it lives (read it once they are joined).
+class LogCapture {
+ public:
+  LogCapture() : previous_(spdlog::default_logger()) {
+    spdlog::set_default_logger(
+        std::make_shared<spdlog::logger>("capture", std::make_shared<spdlog::sinks::ostream_sink_mt>(text_)));
+  }
+  ~LogCapture() { spdlog::set_default_logger(previous_); }
+  LogCapture(const LogCapture&) = delete;
+  LogCapture& operator=(const LogCapture&) = delete;
+  std::string text() const { return text_.str(); }
+
+ private:
+  std::ostringstream text_;
+  std::shared_ptr<spdlog::logger> previous_;
+};
+
+// A pipeline that hangs for 3 s on its 10th frame, saying when the hang begins and ends.
+class HangingProcessor : public FrameProcessor {
+ public:
+  explicit HangingProcessor(std::function<void(bool)> hanging) : hanging_(std::move(hanging)) {}
+  void process(const RigFrameView& f, PoseEstimate& out) override {
+    if (f.sequence == 10) {
+      hanging_(true);
+      std::this_thread::sleep_for(std::chrono::seconds(3));
+      hanging_(false);
+    }
+    out = PoseEstimate{};
+    out.t = f.t;
+    out.sequence = f.sequence;
+    out.state = TrackingState::Tracking;
+    out.valid = true;
+  }
+
+ private:
+  std::function<void(bool)> hanging_;
+};
+}  // namespace
+
+// systemd restarts a daemon whose watchdog pings stop (WatchdogSec=): the supervisor pings only while frames are
+// processed, so a pipeline that hangs gets none (and a log line) for as long as it hangs, and pings again after.
+TEST(McslamdProcess, AHungPipelineGetsNoWatchdogPings) {
+  test::TempDir dir("mcslamd-hang");
+  NotifyListener notify(dir.file("notify.sock"));
+  ASSERT_TRUE(notify.ok());
+  test::writeSmallDataset(dir.file("data"), 2, 30);
+  const platform::DaemonConfig config = platform::parseDaemonConfig(
+      "source:\n  type: dataset\n  dataset:\n    path: data\n    at_end: exit\n"  // 20 Hz
+      "publish:\n  shm:\n    enabled: false\noutput:\n  directory: .\n",
+      dir.file("mcslamd.yaml"));
+  ::setenv("NOTIFY_SOCKET", dir.file("notify.sock").c_str(), 1);
+  ::setenv("WATCHDOG_USEC", "100000", 1);  // a ping every 50 ms while there is progress
+  ::unsetenv("WATCHDOG_PID");
+  int pings_at_hang = -1, pings_after_hang = -1;
+  auto processor = std::make_unique<HangingProcessor>(
+      [&](bool hanging) { (hanging ? pings_at_hang : pings_after_hang) = notify.count("WATCHDOG=1"); });
+  const LogCapture log;
+  const int rc = platform::runDaemon(config, std::move(processor));
+  ::unsetenv("NOTIFY_SOCKET");
+  ::unsetenv("WATCHDOG_USEC");
+  EXPECT_EQ(rc, 0);
+  EXPECT_GE(pings_at_hang, 1) << "pings while frames were processed";
+  EXPECT_LE(pings_after_hang - pings_at_hang, 1) << "pings while the pipeline hung for 3 s";  // one in flight
+  EXPECT_GT(notify.count("WATCHDOG=1"), pings_after_hang) << "pings once frames flowed again";
+  EXPECT_NE(log.text().find("no frame processed for 2 s"), std::string::npos) << log.text();
+  EXPECT_NE(log.text().find("frames flow again"), std::string::npos) << log.text();
+}
+
 TEST(McslamdProcess, OtherSignalsAreAnsweredAndSigquitStopsCleanly) {
   test::TempDir dir("mcslamd-signals");
   NotifyListener notify(dir.file("notify.sock"));

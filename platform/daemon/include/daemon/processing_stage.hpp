@@ -41,6 +41,10 @@ class ProcessingStage {
   uint64_t processed() const { return processed_.load(std::memory_order_relaxed); }
   uint64_t poseDrops() const { return pose_drops_.load(std::memory_order_relaxed); }
   uint64_t waiting() const { return runner_.waiting(); }  // prepared, not yet finished
+  // Frames taken from the rig ring and not yet processed (being prepared, waiting, being finished).
+  uint64_t inFlight() const {
+    return taken_.load(std::memory_order_relaxed) - processed_.load(std::memory_order_relaxed);
+  }
   TrackingState tracking() const { return static_cast<TrackingState>(tracking_.load(std::memory_order_relaxed)); }
   bool unscaled() const { return unscaled_.load(std::memory_order_relaxed); }
   // By the features and processing threads and the processor's own (back-end, loop correction).
@@ -79,7 +83,7 @@ class ProcessingStage {
   std::vector<ImageView> views_;  // onto the images of the rig frame being prepared
   std::thread features_thread_, processing_thread_;
   std::atomic<bool> stop_{false}, done_{false};
-  std::atomic<uint64_t> processed_{0}, pose_drops_{0};
+  std::atomic<uint64_t> taken_{0}, processed_{0}, pose_drops_{0};
   std::atomic<uint8_t> tracking_{0};
   std::atomic<bool> unscaled_{false};
   std::atomic<uint64_t> relocalizations_{0}, loop_closures_{0}, map_merges_{0}, localization_corrections_{0};

@@ -2,13 +2,17 @@
 // The daemon's main thread: builds the Daemon, tells systemd READY=1, then until SIGTERM/SIGINT/SIGQUIT (or the
 // end of a replay with at_end: exit) sends STATUS= and WATCHDOG=1 (only while frames are being
 // processed), logs statistics and state changes, and finally stops everything within 2 s.
+#include <memory>
+
 #include "daemon/daemon_config.hpp"
+#include "mcslam/pipeline/frame_processor.hpp"
 
 namespace mcslam::platform {
 
 // Returns the process exit code: 0 after a clean stop, 1 when the pipeline did not stop in time.
-// Throws InputError when start-up fails (before any thread starts).
-int runDaemon(const DaemonConfig& config);
+// Throws InputError when start-up fails (before any thread starts). `processor`: the pipeline the configuration
+// describes when null (tests give their own).
+int runDaemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> processor = nullptr);
 
 // Formats one status line ("20.0 Hz, tracking, frames 1234, dropped 0, allocs/frame 0.00").
 struct DaemonStats;
