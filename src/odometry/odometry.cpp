@@ -74,7 +74,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   out.t = frame.t;
   out.sequence = frame_index;
   frame_index_ = frame_index;
-  frame_t_ = frame.t;
+  if (!loss_clock_.frame(frame.t)) noteStampNotIncreasing(frame, frame_index);
   settled_count_ = 0;
   rescale_count_ = 0;
   flush();                                // the previous keyframe's solve, before this frame reads the map
@@ -129,17 +129,26 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   out.quality = tracker_->quality(inliers);
 }
 
+// Logged at the 1st, 2nd, 4th, 8th... occurrence: a camera whose clock is stuck would otherwise log every frame.
+void Odometry::noteStampNotIncreasing(const FrameFeatures& frame, uint64_t frame_index) {
+  const uint64_t n = ++stats_.stamps_not_increasing;
+  if ((n & (n - 1)) != 0) return;
+  spdlog::warn(
+      "odometry: frame {} is stamped {:.6f} s, not after the frame before ({} such frames so far: a camera clock "
+      "stepped back, or a frame delivered twice); the time lost is counted without them",
+      frame_index, toSeconds(frame.t), n);
+}
+
 void Odometry::lose(uint64_t frame_index, int inliers, PoseEstimate& out) {
   ++stats_.lost;
-  if (lost_frames_++ == 0) lost_since_ = frame_t_;
+  if (lost_frames_++ == 0) loss_clock_.startLoss();
   spdlog::trace("odometry: frame {}: lost ({} inliers; {} frames in a row)", frame_index, inliers, lost_frames_);
   // Carry on with the motion model so the trajectory stays continuous, and rebuild the map from there when the
   // loss lasts.
   out.T_w_b = tracker_->coast();
   out.state = TrackingState::Lost;
   out.valid = true;
-  const double lost_s = static_cast<double>(frame_t_ - lost_since_) * 1e-9;
-  if (lost_frames_ > options_.max_lost_frames && lost_s >= options_.lost_timeout_s) {
+  if (lost_frames_ > options_.max_lost_frames && loss_clock_.lostSeconds() >= options_.lost_timeout_s) {
     anchor_ = tracker_->pose();
     initialized_ = false;
     resetMap();

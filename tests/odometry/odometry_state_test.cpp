@@ -9,6 +9,7 @@
 #include "alloc_testing.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/odometry/landmark_tracks.hpp"
+#include "mcslam/odometry/loss_clock.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry.hpp"
 #include "mcslam/odometry/rig_state.hpp"
@@ -224,4 +225,21 @@ TEST(WindowBridge, SolvesReachLandmarksByIdAfterSlotReuse) {
   }
   EXPECT_GT(in_window, 40);
   EXPECT_GT(closer, 0.9 * in_window);  // written back to their own slots
+}
+
+// The time lost is the frames' own time since the loss began; a camera clock stepped back an hour (or a frame
+// delivered twice) neither holds the loss open nor ends it early: such stamps add nothing, and are counted.
+TEST(LossClock, AClockSteppedBackDoesNotHoldTheLossOpen) {
+  LossClock clock;
+  const auto at = [](double s) { return static_cast<Timestamp>(s * 1e9); };
+  for (int i = 0; i <= 10; ++i) EXPECT_TRUE(clock.frame(at(3600 + 0.1 * i)));
+  clock.startLoss();  // lost from t = 3601 s
+  EXPECT_TRUE(clock.frame(at(3601.1)));
+  EXPECT_FALSE(clock.frame(at(1.0)));  // the camera's clock stepped back an hour
+  EXPECT_FALSE(clock.frame(at(1.0)));  // a frame delivered twice
+  for (int i = 1; i <= 29; ++i) EXPECT_TRUE(clock.frame(at(1.0 + 0.1 * i)));
+  EXPECT_NEAR(clock.lostSeconds(), 3.0, 1e-6);  // 30 frame periods since the loss began
+  EXPECT_EQ(clock.stampsNotIncreasing(), 2u);
+  clock.startLoss();
+  EXPECT_EQ(clock.lostSeconds(), 0.0);
 }

@@ -140,6 +140,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("keyframes").value(s.keyframes);
   j.key("recoveries").value(s.recoveries);
   j.key("extrinsic_reestimations").value(s.extrinsic_reestimations);
+  j.key("stamps_not_increasing").value(s.stamps_not_increasing);
   j.key("rejected_images").value(pipeline.rejectedImages());
   if (const PlaceMemory* places = pipeline.places()) {
     const PlaceStats& p = places->stats();

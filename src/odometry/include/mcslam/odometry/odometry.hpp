@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "mcslam/odometry/loss_clock.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/map_seed.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
@@ -29,6 +30,7 @@ struct OdometryStats {
   uint64_t relocalizations = 0;  // lost frames the place map found (relocalize())
   uint64_t backend_solves = 0;
   uint64_t extrinsic_reestimations = 0;  // cameras whose extrinsic the per-camera check replaced
+  uint64_t stamps_not_increasing = 0;    // frames stamped at or before the frame before them (LossClock)
   double last_backend_ms = 0;
   // Metric scale of a rig without overlap (started up to scale): frame from which the map is metric (-1: not
   // yet, or the map started metric), the window's scale estimates and the rescalings they caused.
@@ -117,6 +119,7 @@ class Odometry {
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.
   void lose(uint64_t frame_index, int inliers, PoseEstimate& out);
+  void noteStampNotIncreasing(const FrameFeatures& frame, uint64_t frame_index);
   // A keyframe of the tracked frame: its landmarks, new points, and its back-end solve started.
   void makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers, PoseEstimate& out);
   // New landmarks across time for keyframe `slot` (TemporalTriangulator); returns how many.
@@ -143,8 +146,7 @@ class Odometry {
   SE3 anchor_;                 // pose given to the next initialization (continuity after a loss)
   int pending_keyframe_ = -1;  // keyframe whose back-end solve has not been applied yet
   int lost_frames_ = 0;
-  Timestamp lost_since_ = 0;  // capture time of the first frame of the loss
-  Timestamp frame_t_ = 0;     // of the frame being processed
+  LossClock loss_clock_;
   std::array<int32_t, 4> settled_{};
   int settled_count_ = 0;
   std::array<Rescale, 4> rescales_{};
