@@ -6,6 +6,7 @@
 #include "dataset_test_util.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/dataset/dataset.hpp"
+#include "mcslam/dataset/dataset_export.hpp"
 
 using namespace mcslam;
 namespace fs = std::filesystem;
@@ -116,6 +117,16 @@ TEST(KittiRawDataset, CamerasStampedMillisecondsApartShareTheirFramesAndColourIs
   EXPECT_EQ(images[1].data()[0], 12);
   // Grey as a weighted mean of B 10, G 20, R 30: libpng's weights (BT.709) give 21, BT.601's 22.
   EXPECT_NEAR(images[2].data()[0], 21.5, 1.0);
+}
+
+TEST(KittiRawDataset, ConvertedIntoTheEurocLayoutItKeepsItsRigFrames) {
+  test::TempDir dir("kittiraw");
+  const Dataset raw = Dataset::open(writeDrive(dir));
+  exportDataset(raw, DatasetLayoutKind::Euroc, dir.file("euroc"), {ExportImages::Pgm});
+  const Dataset euroc = Dataset::open(dir.file("euroc"));
+  ASSERT_EQ(euroc.size(), raw.size());  // the 6 ms apart stamps, as written, would make 6 frames of one camera
+  EXPECT_EQ(euroc.frames()[2].t, raw.frames()[2].t);
+  EXPECT_FALSE(euroc.frames()[2].image_paths[2].empty());
 }
 
 TEST(KittiRawDataset, CalibrationInTheDriveFolderItself) {
