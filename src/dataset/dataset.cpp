@@ -23,10 +23,16 @@ std::unique_ptr<DatasetLayout> detectLayout(const std::string& dir) {
   const bool has_camchain = fs::exists(d / "camchain.yaml");
   if (!has_camchain && (d.filename() == "mav0" || fs::exists(d / "cam0" / "sensor.yaml"))) return makeEurocLayout(dir);
   if (fs::exists(d / "calib.txt") && fs::is_directory(d / "image_0")) return makeKittiLayout(dir);
+  if (fs::is_directory(d / "image_00")) {
+    const std::optional<std::string> calib = findKittiRawCalibration(dir);
+    if (!calib) throw InputError(dir + ": KITTI raw images (image_00/) but no calib_cam_to_cam.txt here or above");
+    return makeKittiRawLayout(dir, *calib);
+  }
   if (has_camchain || fs::exists(d / "cam0" / "data.csv")) return makeAslLayout(dir);
   throw InputError(dir +
-                   ": not a dataset folder: expected camchain.yaml and camN/data.csv (ASL), mav0/ (EuRoC) or "
-                   "calib.txt, times.txt and image_0/ (KITTI)");
+                   ": not a dataset folder: expected camchain.yaml and camN/data.csv (ASL), mav0/ (EuRoC), "
+                   "calib.txt, times.txt and image_0/ (KITTI odometry) or image_00/ and calib_cam_to_cam.txt (KITTI "
+                   "raw)");
 }
 
 }  // namespace detail
@@ -49,7 +55,7 @@ class DatasetBuilder {
 
     std::vector<std::vector<CameraImage>> images;
     for (int c : selected) images.push_back(layout->listImages(c, ds.warnings_));
-    ds.sync_tolerance_ns_ = options.sync_tolerance_ns > 0 ? options.sync_tolerance_ns : automaticSyncTolerance(images);
+    ds.sync_tolerance_ns_ = options.sync_tolerance_ns > 0 ? options.sync_tolerance_ns : layout->syncTolerance(images);
     ds.frames_ = assembleRigFrames(images, ds.sync_tolerance_ns_);
     noteIncompleteFrames(ds);
 

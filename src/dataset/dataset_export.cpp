@@ -100,12 +100,14 @@ std::vector<std::optional<SE3>> groundTruthPerFrame(const Dataset& dataset) {
 
 namespace {
 
-// The images of every camera over all rig frames.
+// The images of every camera over all rig frames, each stamped with its rig frame's time: the cameras' own stamps
+// may lie further apart than the reader of the written layout groups (KITTI raw's colour cameras stamp ~6 ms
+// before the grey ones), and the written dataset must hold the rig frames that were read.
 std::vector<std::vector<CameraImage>> imagesPerCamera(const Dataset& dataset) {
   std::vector<std::vector<CameraImage>> out(dataset.rig().size());
   for (const RigFrameEntry& f : dataset.frames()) {
     for (int c = 0; c < dataset.rig().size(); ++c) {
-      if (!f.image_paths[c].empty()) out[c].push_back({f.camera_stamps[c], f.image_paths[c]});
+      if (!f.image_paths[c].empty()) out[c].push_back({f.t, f.image_paths[c]});
     }
   }
   return out;

@@ -1,6 +1,6 @@
 #pragma once
-// Internal: one implementation per dataset layout (ASL, EuRoC, KITTI). Dataset::open detects the layout,
-// then works through this interface: calibration, per-camera image lists, ground truth.
+// Internal: one implementation per dataset layout (ASL, EuRoC, KITTI odometry, KITTI raw). Dataset::open detects the
+// layout, then works through this interface: calibration, per-camera image lists, ground truth.
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,6 +30,10 @@ class DatasetLayout {
   virtual Trajectory readGroundTruthFile(const std::string& path, const Rig& rig) const {
     return readTumTrajectory(path);
   }
+  // The tolerance that assembles rig frames from these images when the options give none.
+  virtual Timestamp syncTolerance(const std::vector<std::vector<CameraImage>>& images) const {
+    return automaticSyncTolerance(images);
+  }
 };
 
 // Throws InputError naming the folder when it is no dataset this reader knows.
@@ -38,6 +42,10 @@ std::unique_ptr<DatasetLayout> detectLayout(const std::string& dir);
 std::unique_ptr<DatasetLayout> makeAslLayout(const std::string& root);
 std::unique_ptr<DatasetLayout> makeEurocLayout(const std::string& mav0);
 std::unique_ptr<DatasetLayout> makeKittiLayout(const std::string& root);
+std::unique_ptr<DatasetLayout> makeKittiRawLayout(const std::string& root, const std::string& calibration);
+
+// A KITTI raw drive's calib_cam_to_cam.txt: in the folder or in the (date) folder above it.
+std::optional<std::string> findKittiRawCalibration(const std::string& dir);
 
 // camN/data.csv ("#timestamp [ns],filename") of an ASL or EuRoC camera folder -> images under camN/data/.
 std::vector<CameraImage> readAslImageList(const std::string& camera_dir, std::vector<std::string>& warnings);

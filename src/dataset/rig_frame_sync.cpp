@@ -41,8 +41,7 @@ std::vector<RigFrameEntry> assembleRigFrames(const std::vector<std::vector<Camer
   return frames;
 }
 
-Timestamp automaticSyncTolerance(const std::vector<std::vector<CameraImage>>& per_camera) {
-  constexpr Timestamp kMax = 5000000;  // 5 ms
+Timestamp automaticSyncTolerance(const std::vector<std::vector<CameraImage>>& per_camera, Timestamp max_ns) {
   Timestamp shortest_period = -1;
   for (const auto& images : per_camera) {
     if (images.size() < 2) continue;
@@ -52,8 +51,8 @@ Timestamp automaticSyncTolerance(const std::vector<std::vector<CameraImage>>& pe
     const Timestamp median = periods[periods.size() / 2];
     if (shortest_period < 0 || median < shortest_period) shortest_period = median;
   }
-  if (shortest_period <= 0) return kMax;
-  return std::min(kMax, shortest_period / 3);
+  if (shortest_period <= 0) return std::min<Timestamp>(max_ns, 5000000);
+  return std::min(max_ns, shortest_period / 3);
 }
 
 }  // namespace mcslam

@@ -89,7 +89,8 @@ int main(int argc, char** argv) {
   std::string dir, cameras;
   bool json = false;
   auto* info = app.add_subcommand("info", "Layout, cameras, rig frames, rate and ground truth of a dataset folder");
-  info->add_option("DATASET", dir, "Dataset folder (native ASL, EuRoC mav0/ or KITTI sequence)")->required();
+  info->add_option("DATASET", dir, "Dataset folder (native ASL, EuRoC mav0/, KITTI sequence or KITTI raw drive)")
+      ->required();
   info->add_flag("--json", json,
                  "Print JSON (keys: folder, layout, cameras, rig_frames, complete_rig_frames, duration_s, "
                  "rate_hz, ground_truth_poses, ground_truth_path_m, warnings)");

@@ -65,8 +65,9 @@ FrameRange parseFrameRange(const std::string& option, const std::string& text) {
 }
 
 void addOptions(CLI::App& app, RunOptions& o) {
-  app.add_option("--dataset", o.dataset_dir,
-                 "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, or KITTI)")
+  app.add_option(
+         "--dataset", o.dataset_dir,
+         "Dataset folder (native ASL layout with camchain.yaml, EuRoC mav0/, KITTI odometry or KITTI raw drive)")
       ->required();
   app.add_option("--config", o.config_path,
                  "YAML file with a `slam:` section (see config/slam.yaml); defaults otherwise");
@@ -346,7 +347,7 @@ int runDataset(const RunOptions& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC or KITTI layout)"};
+  CLI::App app{"mcslam-run: run multi-camera SLAM on a dataset (ASL/Kalibr, EuRoC, KITTI odometry or raw layout)"};
   RunOptions options;
   addOptions(app, options);
   CLI11_PARSE(app, argc, argv);

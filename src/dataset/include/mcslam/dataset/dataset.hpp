@@ -9,6 +9,9 @@
 //    (IMU poses, converted into our body frame = cam0).
 //  - KITTI odometry: image_0/, image_1/ (and image_2/, image_3/) PNG, calib.txt (P0..P3), times.txt, optional
 //    poses file (cam0 poses): poses.txt in the folder, ../../poses/<sequence>.txt, or given in the options.
+//  - KITTI raw (synced+rectified drive): image_00/ .. image_03/ with data/<index>.png and timestamps.txt,
+//    calib_cam_to_cam.txt (P_rect_0N, S_rect_0N) in the drive folder or the date folder above it; body frame =
+//    rectified camera 0; colour images read as grey; no ground truth.
 // Images of different cameras are assembled into rig frames by timestamp within a tolerance; a camera
 // without an image at some time gives a rig frame without that camera, never a shifted pairing.
 #include <optional>
@@ -47,7 +50,7 @@ class Dataset {
   // Throws InputError naming the folder and the missing or malformed file.
   static Dataset open(const std::string& dir, const DatasetOptions& options = {});
 
-  const std::string& format() const { return format_; }  // "asl", "euroc" or "kitti"
+  const std::string& format() const { return format_; }  // "asl", "euroc", "kitti" or "kitti_raw"
   const std::string& directory() const { return dir_; }
   const Rig& rig() const { return rig_; }
   const std::vector<RigFrameEntry>& frames() const { return frames_; }

@@ -22,7 +22,8 @@ struct CameraImage {
 std::vector<RigFrameEntry> assembleRigFrames(const std::vector<std::vector<CameraImage>>& per_camera,
                                              Timestamp tolerance_ns);
 
-// A third of the shortest per-camera median frame period, at most 5 ms (5 ms when no camera has two images).
-Timestamp automaticSyncTolerance(const std::vector<std::vector<CameraImage>>& per_camera);
+// A third of the shortest per-camera median frame period, at most max_ns (when no camera has two images: 5 ms, or
+// max_ns if less).
+Timestamp automaticSyncTolerance(const std::vector<std::vector<CameraImage>>& per_camera, Timestamp max_ns = 5000000);
 
 }  // namespace mcslam
