@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "mcslam/core/error.hpp"
 
@@ -10,26 +12,49 @@ namespace mcslam {
 
 namespace {
 
-void rejectDuplicateKeys(const YAML::Node& node, const std::string& path, const std::string& source) {
-  if (node.IsSequence()) {
-    for (std::size_t i = 0; i < node.size(); ++i)
-      rejectDuplicateKeys(node[i], path + "[" + std::to_string(i) + "]", source);
-    return;
+// Walks the parsed tree once per node. yaml-cpp makes an alias the very node its anchor names, so the tree is a
+// graph: a collection reached again through an alias was checked already (a file whose aliases would expand
+// exponentially stays linear), and one reached inside itself is a loop, which no reader of the tree could finish.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(const std::string& source) : source_(source) {}
+
+  void check(const YAML::Node& node, const std::string& path) {
+    if (!node.IsMap() && !node.IsSequence()) return;
+    const int at = node.Mark().pos;  // distinct for every collection of the text
+    if (open_.count(at))
+      throw InputError(source_ + ": line " + std::to_string(node.Mark().line + 1) + ": " +
+                       (path.empty() ? std::string("the document") : path) +
+                       ": an alias refers to a node that contains it (a loop)");
+    if (!done_.insert(at).second) return;
+    open_.insert(at);
+    if (node.IsSequence()) {
+      for (std::size_t i = 0; i < node.size(); ++i) check(node[i], path + "[" + std::to_string(i) + "]");
+    } else {
+      checkMap(node, path);
+    }
+    open_.erase(at);
   }
-  if (!node.IsMap()) return;
-  std::vector<std::pair<std::string, int>> seen;  // key, line
-  for (const auto& entry : node) {
-    const std::string key = entry.first.Scalar();
-    const int line = entry.first.Mark().line + 1;
-    const std::string key_path = path.empty() ? key : path + "." + key;
-    for (const auto& [other, other_line] : seen)
-      if (other == key)
-        throw InputError(source + ": line " + std::to_string(line) + ": " + key_path + ": appears twice in one map " +
-                         "(first at line " + std::to_string(other_line) + ")");
-    seen.emplace_back(key, line);
-    rejectDuplicateKeys(entry.second, key_path, source);
+
+ private:
+  void checkMap(const YAML::Node& node, const std::string& path) {
+    std::unordered_map<std::string, int> seen;  // key -> line
+    for (const auto& entry : node) {
+      const std::string key = entry.first.Scalar();
+      const int line = entry.first.Mark().line + 1;
+      const std::string key_path = path.empty() ? key : path + "." + key;
+      const auto [first, added] = seen.emplace(key, line);
+      if (!added)
+        throw InputError(source_ + ": line " + std::to_string(line) + ": " + key_path +
+                         ": appears twice in one map (first at line " + std::to_string(first->second) + ")");
+      check(entry.second, key_path);
+    }
   }
-}
+
+  const std::string& source_;
+  std::unordered_set<int> done_;
+  std::unordered_set<int> open_;  // the collections being walked (this one and its ancestors)
+};
 
 }  // namespace
 
@@ -40,7 +65,7 @@ YAML::Node parseYamlText(const std::string& text, const std::string& source) {
   } catch (const YAML::Exception& e) {
     throw InputError(source + ": not valid YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
-  rejectDuplicateKeys(root, "", source);
+  DuplicateKeyCheck(source).check(root, "");
   return root;
 }
 

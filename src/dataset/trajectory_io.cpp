@@ -15,8 +15,12 @@ namespace {
 
 std::string lineRef(const std::string& source, int line) { return source + ": line " + std::to_string(line); }
 
+// Whole seconds whose nanoseconds (plus up to a second of fraction) fit an int64: about 292 years.
+constexpr int64_t kMaxWholeSeconds = INT64_MAX / 1000000000 - 1;
+
 // Parses "1311868164.363181" (or "1e9", "-3.5") as nanoseconds without going through a double when it
-// is a plain decimal, so that stamps with 16 significant digits keep every digit.
+// is a plain decimal, so that stamps with 16 significant digits keep every digit. False for anything else,
+// and for times beyond kMaxWholeSeconds.
 bool parseSecondsToNs(const std::string& s, Timestamp& out) {
   std::size_t i = 0;
   bool neg = false;
@@ -26,8 +30,8 @@ bool parseSecondsToNs(const std::string& s, Timestamp& out) {
   int frac_digits = 0;
   bool any = false;
   for (; i < s.size() && std::isdigit(static_cast<unsigned char>(s[i])); ++i, any = true) {
-    if (whole > (INT64_MAX / 10 - 10) / 1000000000) return false;
     whole = whole * 10 + (s[i] - '0');
+    if (whole > kMaxWholeSeconds) return false;
   }
   if (i < s.size() && s[i] == '.') {
     for (++i; i < s.size() && std::isdigit(static_cast<unsigned char>(s[i])); ++i, any = true) {
@@ -44,7 +48,7 @@ bool parseSecondsToNs(const std::string& s, Timestamp& out) {
   if (i != s.size()) {  // exponent or junk: fall back to a double
     char* end = nullptr;
     const double v = std::strtod(s.c_str(), &end);
-    if (end != s.c_str() + s.size() || !std::isfinite(v)) return false;
+    if (end != s.c_str() + s.size() || !(std::abs(v) <= static_cast<double>(kMaxWholeSeconds))) return false;
     out = fromSeconds(v);
     return true;
   }
@@ -95,7 +99,8 @@ Trajectory parseTumTrajectory(const std::string& text, const std::string& source
     }
     StampedPose p;
     if (!parseSecondsToNs(tok[0], p.t)) {
-      throw InputError(lineRef(source, line_no) + ": timestamp is not a number: '" + tok[0] + "'");
+      throw InputError(lineRef(source, line_no) + ": timestamp is not a number of seconds (at most 9.2e9): '" + tok[0] +
+                       "'");
     }
     double v[8];
     for (int k = 1; k < 8; ++k) v[k] = parseNumber(tok[k], lineRef(source, line_no), kNames[k]);
@@ -143,7 +148,8 @@ std::vector<Timestamp> readTimesFile(const std::string& path) {
     std::string tok, extra;
     if (!(ls >> tok) || tok[0] == '#') continue;
     Timestamp t;
-    if (!parseSecondsToNs(tok, t)) throw InputError(lineRef(path, line_no) + ": time is not a number: '" + tok + "'");
+    if (!parseSecondsToNs(tok, t))
+      throw InputError(lineRef(path, line_no) + ": time is not a number of seconds (at most 9.2e9): '" + tok + "'");
     if (ls >> extra) throw InputError(lineRef(path, line_no) + ": expected one time in seconds, got '" + line + "'");
     times.push_back(t);
   }

@@ -120,3 +120,11 @@ TEST(Trajectory, PathLengthSumsTheSteps) {
   EXPECT_DOUBLE_EQ(pathLength(t), 7.0);
   EXPECT_EQ(pathLength({}), 0.0);
 }
+
+TEST(TumTrajectory, TimesBeyondWhatNanosecondsHoldAreErrors) {
+  expectError([] { parseTumTrajectory("1e300 0 0 0 0 0 0 1\n", "gt.txt"); },
+              {"gt.txt: line 1", "timestamp", "'1e300'"});
+  expectError([] { parseTumTrajectory("9223372039.5 0 0 0 0 0 0 1\n", "gt.txt"); }, {"gt.txt: line 1", "timestamp"});
+  expectError([] { parseTumTrajectory("-9223372039 0 0 0 0 0 0 1\n", "gt.txt"); }, {"gt.txt: line 1", "timestamp"});
+  EXPECT_EQ(parseTumTrajectory("9223372035.5 0 0 0 0 0 0 1\n", "gt.txt").at(0).t, int64_t{9223372035500000000});
+}
