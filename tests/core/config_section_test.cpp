@@ -15,7 +15,10 @@ std::string aliasBomb() {
   for (int level = 1; level < 10; ++level) {
     const std::string prev = "*l" + std::to_string(level - 1);
     text += "l" + std::to_string(level) + ": &l" + std::to_string(level) + " [";
-    for (int i = 0; i < 10; ++i) text += (i ? ", " : "") + prev;
+    for (int i = 0; i < 10; ++i) {
+      if (i > 0) text += ", ";  // not (i ? ", " : "") + prev: GCC 12 warns falsely (-Wrestrict) on that
+      text += prev;
+    }
     text += "]\n";
   }
   return text;
