@@ -12,11 +12,11 @@ namespace {
 // The "billion laughs": nine levels of ten aliases each, 10^9 leaves when expanded.
 std::string aliasBomb() {
   std::string text = "l0: &l0 [x, x, x, x, x, x, x, x, x, x]\n";
-  for (int level = 1; level < 10; ++level) {
-    const std::string prev = "*l" + std::to_string(level - 1);
-    text += "l" + std::to_string(level) + ": &l" + std::to_string(level) + " [";
-    for (int i = 0; i < 10; ++i) text += (i ? ", " : "") + prev;
-    text += "]\n";
+  for (char level = '1'; level <= '9'; ++level) {
+    const std::string name(1, level), prev(1, static_cast<char>(level - 1));
+    text.append("l").append(name).append(": &l").append(name).append(" [");
+    for (int i = 0; i < 10; ++i) text.append(i ? ", *l" : "*l").append(prev);
+    text.append("]\n");
   }
   return text;
 }
@@ -49,4 +49,12 @@ TEST(ParseYamlText, AnAliasInsideItsOwnAnchorIsALoopError) {
 TEST(ParseYamlText, ADuplicateKeyNamesBothLines) {
   EXPECT_NE(errorOf("x: 1\ny: {a: 1}\nx: 2\n").find("f.yaml: line 3: x: appears twice in one map (first at line 1)"),
             std::string::npos);
+}
+
+// Readers take keys as words (as<std::string>()): a list or map as a key is refused where the file is parsed.
+TEST(ParseYamlText, AKeyThatIsAListOrMapIsAnError) {
+  EXPECT_NE(errorOf("cam0:\n  ? [a, b]\n  : 1\n").find("f.yaml: line 2: cam0: a key must be a word, got a list"),
+            std::string::npos)
+      << errorOf("cam0:\n  ? [a, b]\n  : 1\n");
+  EXPECT_NE(errorOf("{x: 1}: 2\n").find("a key must be a word, got a map"), std::string::npos);
 }
