@@ -11,7 +11,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   static const std::string file = mcslam::fuzz::tempFolder().dir() + "/mcslamd.yaml";
   try {
-    const mcslam::platform::DaemonConfig config = mcslam::platform::parseDaemonConfig(mcslam::fuzz::text(data, size), file);
+    const mcslam::platform::DaemonConfig config =
+        mcslam::platform::parseDaemonConfig(mcslam::fuzz::text(data, size), file);
     (void)mcslam::platform::effectiveDaemonConfig(config);
   } catch (const mcslam::InputError&) {
   }
