@@ -1,5 +1,6 @@
 #include "mcslam/pipeline/pipeline_config.hpp"
 
+#include <cstdio>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -130,6 +131,25 @@ void readPlaces(ConfigSection s, PipelineConfig& c) {
   checkPlaceSlots(s, "max_words_per_keyframe", p.max_words_per_keyframe, p.max_keyframes, "word");
 }
 
+// A YAML double-quoted scalar that reads back as `s`: a path may hold quotes, backslashes or control characters.
+std::string yamlQuoted(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20 || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+      out += escaped;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
 }  // namespace
 
 const char* refineExtrinsicsName(RefineExtrinsics r) {
@@ -215,7 +235,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    extrinsic_sigma_rotation_deg: " << o.extrinsic_sigma_rotation_deg << "\n"
      << "  places:\n"
      << "    enabled: " << (c.places.enabled ? "true" : "false") << "\n"
-     << "    vocabulary: \"" << c.places.vocabulary << "\"\n"
+     << "    vocabulary: " << yamlQuoted(c.places.vocabulary) << "\n"
      << "    max_keyframes: " << c.places.max_keyframes << "\n"
      << "    max_points_per_keyframe: " << c.places.max_points_per_keyframe << "\n"
      << "    max_words_per_keyframe: " << c.places.max_words_per_keyframe << "\n"

@@ -109,3 +109,11 @@ TEST(PipelineConfig, CapacitiesBeyondAMachineAndTooManyCamerasAreErrors) {
     EXPECT_NE(std::string(e.what()).find("at most 64 cameras per rig (got 65)"), std::string::npos) << e.what();
   }
 }
+
+// The effective configuration (`--check-config`) quotes a vocabulary path so that it reads back, whatever it holds.
+TEST(PipelineConfig, EffectiveConfigQuotesTheVocabularyPath) {
+  PipelineConfig c;
+  c.places.vocabulary = "dir \"x\"\\voc\ttab.bin";
+  const YAML::Node back = YAML::Load(formatPipelineConfig(c));
+  EXPECT_EQ(parsePipelineConfig(back["slam"], "effective", isec()).places.vocabulary, c.places.vocabulary);
+}
