@@ -30,6 +30,10 @@ while (($#)); do
   shift
 done
 
+# Debian 12's clang and its libFuzzer runtime; the libraries' own dependencies come with tools/setup.sh.
+source tools/install-packages.sh
+install_missing fuzz clang libclang-rt-14-dev
+
 build=build-fuzz
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)

@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # Sets up (packages + build) and runs the whole test suite through CTest.
 # Usage: tools/run-tests.sh [--ci]
-#   --ci   what CI runs (.ci/run): the build with -Werror, the suite, the formatter check (tools/check-format.sh)
-#          and the sanitizer jobs (tools/run-sanitizers.sh: ASan+UBSan over the suite, TSan over the threaded tests)
+#   --ci   what CI runs (.ci/run): the build with -Werror, the suite, the formatter check (tools/check-format.sh),
+#          the sanitizer jobs (tools/run-sanitizers.sh: ASan+UBSan over the suite, TSan over the threaded tests)
+#          and a short run of the fuzz targets that build from the lower libraries (tools/fuzz.sh --ci)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ci=0
 case "${1:-}" in
   "") ;;
   --ci) ci=1 ;;
-  -h|--help) sed -n '2,5p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   *) echo "run-tests: unknown option '$1' (see --help)" >&2; exit 2 ;;
 esac
 
@@ -22,4 +23,5 @@ fi
 ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
 if ((ci)); then
   tools/run-sanitizers.sh all
+  tools/fuzz.sh --ci --runs 5000  # about 3 minutes on two cores, the build included (BENCHMARKS.md, "Fuzzing")
 fi

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -152,6 +153,23 @@ YAML::Node parseYaml(const std::string& text, const std::string& source) {
   return parseYamlText(stripOpenCvHeader(text), source);
 }
 
+// N of a key "camN"; -1 for a key that names no camera. InputError for N beyond the cameras a rig may have, or
+// written with leading zeros (cam01 would be camera 1 beside cam1).
+int cameraIndex(const std::string& key, const std::string& source) {
+  if (key.size() <= 3 || key.compare(0, 3, "cam") != 0 ||
+      !std::all_of(key.begin() + 3, key.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return -1;
+  int index = -1;
+  const auto [end, ec] = std::from_chars(key.data() + 3, key.data() + key.size(), index);
+  if (ec != std::errc() || index >= kMaxRigCameras)
+    throw InputError(source + ": " + key + ": a rig has at most " + std::to_string(kMaxRigCameras) +
+                     " cameras (cam0 to cam" + std::to_string(kMaxRigCameras - 1) + ")");
+  if (key != "cam" + std::to_string(index))
+    throw InputError(source + ": " + key + ": camera keys are written without leading zeros (cam" +
+                     std::to_string(index) + ")");
+  return index;
+}
+
 void applyBody(Rig& rig, const RigLoadOptions& options) {
   if (options.T_body_cam0) rig.rebase(*options.T_body_cam0);
 }
@@ -184,11 +202,8 @@ Rig parseKalibrRig(const std::string& yaml_text, const std::string& source, cons
 
   std::map<int, YAML::Node> cams;
   for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    if (key.size() > 3 && key.compare(0, 3, "cam") == 0 &&
-        std::all_of(key.begin() + 3, key.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-      cams[std::stoi(key.substr(3))] = kv.second;
-    }
+    const int index = cameraIndex(kv.first.as<std::string>(), source);
+    if (index >= 0) cams[index] = kv.second;
   }
   if (cams.empty()) throw InputError(source + ": no cameras found (expected keys cam0, cam1, ...)");
   int expected = 0;
@@ -235,6 +250,8 @@ Rig parseKalibrRig(const std::string& yaml_text, const std::string& source, cons
 
 Rig loadEurocSensorRig(const std::vector<std::string>& paths, const RigLoadOptions& options) {
   if (paths.empty()) throw InputError("EuRoC rig: no sensor.yaml files given");
+  if (paths.size() > static_cast<std::size_t>(kMaxRigCameras))
+    throw InputError(paths[kMaxRigCameras] + ": a rig has at most " + std::to_string(kMaxRigCameras) + " cameras");
   Rig rig;
   std::vector<SE3> T_B_c;
   for (std::size_t i = 0; i < paths.size(); ++i) {

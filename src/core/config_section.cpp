@@ -40,8 +40,11 @@ class DuplicateKeyCheck {
   void checkMap(const YAML::Node& node, const std::string& path) {
     std::unordered_map<std::string, int> seen;  // key -> line
     for (const auto& entry : node) {
-      const std::string key = entry.first.Scalar();
       const int line = entry.first.Mark().line + 1;
+      if (entry.first.IsMap() || entry.first.IsSequence())  // no file of ours has them; readers take keys as words
+        throw InputError(source_ + ": line " + std::to_string(line) + ": " + (path.empty() ? "the document" : path) +
+                         ": a key must be a word, got a " + (entry.first.IsMap() ? "map" : "list"));
+      const std::string key = entry.first.Scalar();
       const std::string key_path = path.empty() ? key : path + "." + key;
       const auto [first, added] = seen.emplace(key, line);
       if (!added)

@@ -117,7 +117,10 @@ std::vector<CameraImage> readAslImageList(const std::string& camera_dir, std::ve
     }
     if (fields[1].empty()) throw InputError(where + ": the file name is empty");
     const fs::path path = data / fields[1];
-    const bool exists = fields[1].find('/') == std::string::npos ? present.count(fields[1]) > 0 : fs::exists(path);
+    // A name the file system refuses (too long, ...) is as missing as one it does not have.
+    std::error_code lookup;
+    const bool exists =
+        fields[1].find('/') == std::string::npos ? present.count(fields[1]) > 0 : fs::exists(path, lookup);
     if (!exists) {
       missing.add(where, path.string());
       continue;

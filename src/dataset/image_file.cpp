@@ -4,6 +4,7 @@
 #include "mcslam/dataset/image_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,6 +33,12 @@ class FileDescriptor {
   ~FileDescriptor() { ::close(fd_); }
   FileDescriptor(const FileDescriptor&) = delete;
   FileDescriptor& operator=(const FileDescriptor&) = delete;
+
+  // The file's size when it is a regular file (-1 for a pipe or a device: only reading tells).
+  long long regularSize() const {
+    struct stat st {};
+    return ::fstat(fd_, &st) == 0 && S_ISREG(st.st_mode) ? static_cast<long long>(st.st_size) : -1;
+  }
 
   // Reads until n bytes or the end of the file; returns the bytes read.
   std::size_t read(uint8_t* out, std::size_t n, const std::string& path) const {
@@ -80,6 +87,12 @@ InputError tooLarge(const std::string& path, long width, long height, ImageBound
                     std::to_string(bound.width) + "x" + std::to_string(bound.height) + " this camera has; not decoded");
 }
 
+[[noreturn]] void throwTruncated(const std::string& path, long long got, long width, long height) {
+  throw InputError(path + ": PGM truncated: " + std::to_string(std::max(got, 0LL)) + " of " +
+                   std::to_string(width * height) + " pixel bytes (" + std::to_string(width) + "x" +
+                   std::to_string(height) + ")");
+}
+
 // Parses the header in head[0, n) (magic already checked), then reads the pixels: those already in `head` and
 // the rest straight from the file into `image`.
 void readPgmPixels(const FileDescriptor& file, const std::string& path, const uint8_t* head, std::size_t n,
@@ -100,14 +113,16 @@ void readPgmPixels(const FileDescriptor& file, const std::string& path, const ui
                      (maxval == kSaturated ? " or more" : "") + " (only 8-bit grey with maxval 255 is read" +
                      (maxval > 255 ? "; this is a 16-bit image)" : ")"));
   if (!bound.admits(static_cast<int>(width), static_cast<int>(height))) throw tooLarge(path, width, height, bound);
-  image.resize(static_cast<int>(width), static_cast<int>(height));
   const std::size_t total = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  // A short file is refused before the image grows to what its header claims (up to 1 GB for a few bytes).
+  const long long size = file.regularSize();
+  if (size >= 0 && static_cast<unsigned long long>(size) < pos + total)
+    throwTruncated(path, size - static_cast<long long>(pos), width, height);
+  image.resize(static_cast<int>(width), static_cast<int>(height));
   const std::size_t buffered = std::min(n - std::min(pos, n), total);
   std::memcpy(image.data(), head + pos, buffered);
   const std::size_t got = buffered + file.read(image.data() + buffered, total - buffered, path);
-  if (got < total)
-    throw InputError(path + ": PGM truncated: " + std::to_string(got) + " of " + std::to_string(total) +
-                     " pixel bytes (" + std::to_string(width) + "x" + std::to_string(height) + ")");
+  if (got < total) throwTruncated(path, static_cast<long long>(got), width, height);
 }
 
 std::string printableMagic(const uint8_t* head, std::size_t n) {

@@ -1,5 +1,6 @@
 #include "mcslam/pipeline/pipeline_config.hpp"
 
+#include <cstdio>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -100,6 +101,19 @@ void readBackend(ConfigSection s, PipelineConfig& c) {
   s.finish();
 }
 
+// The place map and its database are allocated whole at start, max_keyframes times a per-keyframe capacity each:
+// each capacity is in range alone, but their product must not ask for more memory than a machine has (the defaults
+// ask for 0.9 M point and 3 M word slots).
+constexpr int64_t kMaxPlaceSlots = int64_t{1} << 27;
+
+void checkPlaceSlots(const ConfigSection& s, const char* key, int per_keyframe, int keyframes, const char* what) {
+  const int64_t slots = int64_t{per_keyframe} * keyframes;
+  if (slots > kMaxPlaceSlots)
+    s.fail(key, std::to_string(per_keyframe) + " times max_keyframes " + std::to_string(keyframes) + " is " +
+                    std::to_string(slots) + " " + what + " slots, more than the " + std::to_string(kMaxPlaceSlots) +
+                    " place memory may allocate at start");
+}
+
 void readPlaces(ConfigSection s, PipelineConfig& c) {
   PlacesOptions& p = c.places;
   s.read("enabled", p.enabled);
@@ -113,6 +127,27 @@ void readPlaces(ConfigSection s, PipelineConfig& c) {
   s.read("loop_min_keyframes_apart", p.loop_min_keyframes_apart, 1, 1000000);
   s.read("max_loops", p.max_loops, 1, 1000000);
   s.finish();
+  checkPlaceSlots(s, "max_points_per_keyframe", p.max_points_per_keyframe, p.max_keyframes, "point");
+  checkPlaceSlots(s, "max_words_per_keyframe", p.max_words_per_keyframe, p.max_keyframes, "word");
+}
+
+// A YAML double-quoted scalar that reads back as `s`: a path may hold quotes, backslashes or control characters.
+std::string yamlQuoted(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20 || c == 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+      out += escaped;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
 }
 
 }  // namespace
@@ -200,7 +235,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    extrinsic_sigma_rotation_deg: " << o.extrinsic_sigma_rotation_deg << "\n"
      << "  places:\n"
      << "    enabled: " << (c.places.enabled ? "true" : "false") << "\n"
-     << "    vocabulary: \"" << c.places.vocabulary << "\"\n"
+     << "    vocabulary: " << yamlQuoted(c.places.vocabulary) << "\n"
      << "    max_keyframes: " << c.places.max_keyframes << "\n"
      << "    max_points_per_keyframe: " << c.places.max_points_per_keyframe << "\n"
      << "    max_words_per_keyframe: " << c.places.max_words_per_keyframe << "\n"

@@ -146,6 +146,19 @@ TEST(KalibrRig, BadCalibrationNamesFileCameraAndField) {
   }
 }
 
+// A rig has at most 64 cameras (kMaxRigCameras): a file with more, or with a camera index no int holds, is refused
+// by name; cam01 beside cam1 would be two keys for one camera.
+TEST(KalibrRig, CameraKeysAreBoundedAndWrittenOnce) {
+  Rig rig = parseKalibrRig(kTwoCams, "two.yaml");
+  while (rig.size() < kMaxRigCameras) rig.cameras.push_back(rig.cameras[1]);
+  const std::string sixty_four = formatKalibrRig(rig);
+  EXPECT_EQ(parseKalibrRig(sixty_four, "64.yaml").size(), 64);
+  rig.cameras.push_back(rig.cameras[1]);
+  expectRejected(formatKalibrRig(rig), {"rig.yaml: cam64: a rig has at most 64 cameras"});
+  expectRejected("cam99999999999: {}\n", {"rig.yaml: cam99999999999: a rig has at most 64 cameras"});
+  expectRejected(replaced(kTwoCams, "cam1:", "cam01:"), {"rig.yaml: cam01", "without leading zeros"});
+}
+
 TEST(Rig, SubsetKeepsTheBodyFrame) {
   const Rig rig = loadKalibrRig(test::dataPath("calib/isec_5cam_camchain.yaml"));
   const Rig sub = rig.subset(parseCameraList("4,2"));

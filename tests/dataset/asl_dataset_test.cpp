@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "dataset_test_util.hpp"
 #include "mcslam/calib/calibration_io.hpp"
@@ -96,6 +97,16 @@ TEST(AslDataset, AListedButMissingFileIsAWarningAndTheFrameStays) {
   EXPECT_TRUE(ds.frames()[1].image_paths[2].empty());
   EXPECT_FALSE(ds.frames()[1].image_paths[0].empty());
   EXPECT_TRUE(contains(ds.warnings(), root + "/cam2/data.csv: line 3: image " + gone + " is listed but missing"));
+}
+
+// A listed name the file system refuses to look up (a folder name beyond NAME_MAX) is missing like any other.
+TEST(AslDataset, AListedNameTheFileSystemRefusesIsMissingNotAnException) {
+  test::TempDir dir("asl");
+  const std::string root = writeDataset(dir);
+  std::ofstream(root + "/cam2/data.csv", std::ios::app) << stamp(9) << ",sub" << std::string(300, 'x') << "/a.png\n";
+  const Dataset ds = Dataset::open(root);
+  EXPECT_EQ(ds.size(), 5u);
+  EXPECT_TRUE(contains(ds.warnings(), root + "/cam2/data.csv: line 7: image "));
 }
 
 TEST(AslDataset, AnUnreadableImageIsReportedAndItsCameraMarkedAbsent) {

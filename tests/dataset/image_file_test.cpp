@@ -89,6 +89,21 @@ TEST(PgmFile, TruncatedPixelsAreAnErrorSayingHowManyBytesCame) {
   EXPECT_NE(cut_header.find("height missing (file truncated)"), std::string::npos) << cut_header;
 }
 
+// A file far shorter than its header claims is refused before the image takes the claimed size.
+TEST(PgmFile, AShortFileClaimingAHugeImageAllocatesNothing) {
+  test::TempDir dir("pgm_claim");
+  const std::string path = test::writeFile(dir.file("claim.pgm"), "P5\n30000 30000\n255\n" + std::string(5, 'x'));
+  Image image;
+  try {
+    readPgmFile(path, image);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated: 5 of 900000000 pixel bytes (30000x30000)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(image.width(), 0);  // never resized to 30000x30000
+}
+
 TEST(PgmFile, WrongMagicIsAnErrorNamingWhatTheFileStartsWith) {
   test::TempDir dir("pgm_magic");
   const std::string ascii = pgmError(dir, "P2\n2 1\n255\n1 2\n");

@@ -28,7 +28,7 @@ void readSegment(const uint8_t* data, std::size_t size) {
       mcslam::pose::PoseRecord record;
       (void)reader.readLatest(record);
       const uint64_t newest = reader.published();
-      for (uint64_t seq = newest > 4 ? newest - 4 : 0; seq <= newest + 1; ++seq) (void)reader.readSequence(seq, record);
+      for (uint64_t back = 0; back < 6; ++back) (void)reader.readSequence(newest + 1 - back, record);  // wraps: fine
     }
   }
   ::shm_unlink(segmentName().c_str());

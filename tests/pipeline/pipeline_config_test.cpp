@@ -84,3 +84,36 @@ TEST(PipelineConfig, ShippedSlamYamlHoldsTheDefaults) {
   const PipelineConfig defaults = parsePipelineConfig(YAML::Node(), "defaults", isec());
   EXPECT_EQ(formatPipelineConfig(shipped), formatPipelineConfig(defaults));
 }
+
+// Capacities are allocated at start: a huge one, alone or as a product of two in range, is an error naming the key
+// and the value before anything is allocated; so is a rig beyond 64 cameras.
+TEST(PipelineConfig, CapacitiesBeyondAMachineAndTooManyCamerasAreErrors) {
+  EXPECT_NE(errorOf("capacity: {max_landmarks: 1000000000000}")
+                .find("slam.capacity.max_landmarks: must be an integer in [500, 2000000], got '1000000000000'"),
+            std::string::npos);
+  const std::string words =
+      errorOf("places: {max_keyframes: 1000000, max_points_per_keyframe: 50, max_words_per_keyframe: 1000000}");
+  EXPECT_NE(words.find("run.yaml: slam.places.max_words_per_keyframe: 1000000 times max_keyframes 1000000 is "
+                       "1000000000000 word slots"),
+            std::string::npos)
+      << words;
+  EXPECT_NE(errorOf("places: {max_keyframes: 1000000}")
+                .find("slam.places.max_points_per_keyframe: 600 times max_keyframes 1000000 is 600000000 point slots"),
+            std::string::npos);
+  Rig many = isec();
+  while (many.size() <= 64) many.cameras.push_back(many.cameras[0]);
+  try {
+    parsePipelineConfig(YAML::Node(), "run.yaml", many);
+    FAIL() << "65 cameras accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("at most 64 cameras per rig (got 65)"), std::string::npos) << e.what();
+  }
+}
+
+// The effective configuration (`--check-config`) quotes a vocabulary path so that it reads back, whatever it holds.
+TEST(PipelineConfig, EffectiveConfigQuotesTheVocabularyPath) {
+  PipelineConfig c;
+  c.places.vocabulary = "dir \"x\"\\voc\ttab.bin";
+  const YAML::Node back = YAML::Load(formatPipelineConfig(c));
+  EXPECT_EQ(parsePipelineConfig(back["slam"], "effective", isec()).places.vocabulary, c.places.vocabulary);
+}

@@ -14,6 +14,10 @@
 
 namespace mcslam {
 
+// The most cameras a rig file may hold: multi-view features keep one bit per camera (track_builder), and the
+// pipeline and the map file refuse more.
+inline constexpr int kMaxRigCameras = 64;
+
 struct RigLoadOptions {
   // Pose of cam0 in the desired body frame; identity (body = cam0) when absent.
   std::optional<SE3> T_body_cam0;
