@@ -34,14 +34,6 @@ std::vector<std::string> splitCsv(const std::string& line) {
 }
 
 // File names present in a folder, listed once instead of asking the file system for each image.
-std::unordered_set<std::string> fileNames(const fs::path& dir) {
-  std::unordered_set<std::string> names;
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-    names.insert(it->path().filename().string());
-  return names;
-}
-
 class AslLayout : public DatasetLayout {
  public:
   explicit AslLayout(std::string root) : root_(std::move(root)) {}
@@ -73,6 +65,14 @@ class AslLayout : public DatasetLayout {
 };
 
 }  // namespace
+
+std::unordered_set<std::string> fileNames(const fs::path& dir) {
+  std::unordered_set<std::string> names;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    names.insert(it->path().filename().string());
+  return names;
+}
 
 void MissingImageReport::add(const std::string& where, const std::string& path) {
   if (++count_ <= kListedMissing) {

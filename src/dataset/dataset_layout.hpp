@@ -1,9 +1,11 @@
 #pragma once
 // Internal: one implementation per dataset layout (ASL, EuRoC, KITTI odometry, KITTI raw). Dataset::open detects the
 // layout, then works through this interface: calibration, per-camera image lists, ground truth.
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "mcslam/calib/rig.hpp"
@@ -49,6 +51,15 @@ std::optional<std::string> findKittiRawCalibration(const std::string& dir);
 
 // camN/data.csv ("#timestamp [ns],filename") of an ASL or EuRoC camera folder -> images under camN/data/.
 std::vector<CameraImage> readAslImageList(const std::string& camera_dir, std::vector<std::string>& warnings);
+
+// The names of the files in `dir` (none when it cannot be read).
+std::unordered_set<std::string> fileNames(const std::filesystem::path& dir);
+
+// The images of camera `cam` in `dir` named by their index (`name(i)`), one for each of `times` (read from
+// `times_path`, which messages name by line): a missing one is a warning, times that do not increase an InputError.
+std::vector<CameraImage> indexedImages(const std::filesystem::path& dir, int cam, const std::vector<Timestamp>& times,
+                                       const std::string& times_path, std::string (*name)(std::size_t),
+                                       std::vector<std::string>& warnings);
 
 // Collects "listed but missing" warnings for one camera, summarising after the first few.
 class MissingImageReport {

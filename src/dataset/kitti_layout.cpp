@@ -48,29 +48,10 @@ class KittiLayout : public DatasetLayout {
   }
 
   std::vector<CameraImage> listImages(int cam, std::vector<std::string>& warnings) const override {
-    const std::vector<Timestamp>& t = times();
     const fs::path dir = cameraDir(cam);
     if (!fs::is_directory(dir))
       throw InputError(dir.string() + ": missing (the images of cam" + std::to_string(cam) + ")");
-    std::unordered_set<std::string> present;
-    std::error_code ec;
-    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-      present.insert(it->path().filename().string());
-    MissingImageReport missing("cam" + std::to_string(cam), warnings);
-    std::vector<CameraImage> images;
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      const std::string name = imageName(i);
-      if (!present.count(name)) {
-        missing.add(timesPath() + ": line " + std::to_string(i + 1), (dir / name).string());
-        continue;
-      }
-      if (!images.empty() && t[i] <= images.back().t) {
-        throw InputError(timesPath() + ": line " + std::to_string(i + 1) + ": times must increase");
-      }
-      images.push_back({t[i], (dir / name).string()});
-    }
-    missing.finish();
-    return images;
+    return indexedImages(dir, cam, times(), timesPath(), imageName, warnings);
   }
 
   std::optional<Trajectory> loadGroundTruth(const Rig& rig, std::vector<std::string>&,
@@ -124,6 +105,26 @@ class KittiLayout : public DatasetLayout {
 };
 
 }  // namespace
+
+std::vector<CameraImage> indexedImages(const fs::path& dir, int cam, const std::vector<Timestamp>& times,
+                                       const std::string& times_path, std::string (*name)(std::size_t),
+                                       std::vector<std::string>& warnings) {
+  const std::unordered_set<std::string> present = fileNames(dir);
+  MissingImageReport missing("cam" + std::to_string(cam), warnings);
+  std::vector<CameraImage> images;
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    const std::string where = times_path + ": line " + std::to_string(i + 1);
+    const std::string file = name(i);
+    if (!present.count(file)) {
+      missing.add(where, (dir / file).string());
+      continue;
+    }
+    if (!images.empty() && times[i] <= images.back().t) throw InputError(where + ": times must increase");
+    images.push_back({times[i], (dir / file).string()});
+  }
+  missing.finish();
+  return images;
+}
 
 std::unique_ptr<DatasetLayout> makeKittiLayout(const std::string& root) { return std::make_unique<KittiLayout>(root); }
 

@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <limits>
 #include <sstream>
-#include <unordered_set>
 
 #include "dataset_layout.hpp"
 #include "kitti_calib.hpp"
@@ -104,24 +103,7 @@ class KittiRawLayout : public DatasetLayout {
     const std::string times_path = (cameraDir(cam) / "timestamps.txt").string();
     if (!fs::exists(times_path))
       throw InputError(times_path + ": missing (the times of cam" + std::to_string(cam) + ")");
-    const std::vector<Timestamp> t = readDateTimes(times_path);
-    std::unordered_set<std::string> present;
-    std::error_code ec;
-    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-      present.insert(it->path().filename().string());
-    MissingImageReport missing("cam" + std::to_string(cam), warnings);
-    std::vector<CameraImage> images;
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      const std::string where = times_path + ": line " + std::to_string(i + 1);
-      if (!present.count(imageName(i))) {
-        missing.add(where, (dir / imageName(i)).string());
-        continue;
-      }
-      if (!images.empty() && t[i] <= images.back().t) throw InputError(where + ": times must increase");
-      images.push_back({t[i], (dir / imageName(i)).string()});
-    }
-    missing.finish();
-    return images;
+    return indexedImages(dir, cam, readDateTimes(times_path), times_path, imageName, warnings);
   }
 
   std::optional<Trajectory> loadGroundTruth(const Rig&, std::vector<std::string>&, std::string*) const override {

@@ -1,8 +1,7 @@
 #pragma once
-// How long tracking has been lost, in the frames' own time (relocalization_timeout_s is measured with it). A
-// stamp that is not after the one before (a camera clock stepped back, a frame delivered twice) adds nothing: with
-// "now minus the first lost stamp", a clock stepped back by an hour kept the loss open for that hour. Stamps that
-// do not increase are counted for the stats.
+// How long tracking has been lost, in the frames' own time (relocalization_timeout_s is measured with it), summed
+// frame by frame: a stamp that is not after the one before (a camera clock stepped back, a frame delivered twice)
+// adds nothing, so a clock stepped back cannot hold a loss open. Stamps that do not increase are counted.
 #include <cstdint>
 
 #include "mcslam/core/time.hpp"
