@@ -148,7 +148,7 @@ void Daemon::writeRefinedExtrinsics() {
 // Approximate (the counters are read one after the other); stop() drains whatever is still in flight.
 bool Daemon::drained() const {
   if (!source_->finished() || assembly_.assembler().pendingFrames() != 0 || rig_ring_.size() != 0 ||
-      pose_ring_.size() != 0 || processing_.waiting() != 0 || processing_.inFlight() != 0)
+      pose_ring_.size() != 0 || processing_.inFlight() != 0)
     return false;
   for (int c = 0; c < camera_rings_.cameras(); ++c)
     if (camera_rings_.ring(c).size() != 0) return false;

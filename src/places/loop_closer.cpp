@@ -78,7 +78,6 @@ bool LoopCloser::collectDetection(const PlaceMap& map, bool wait) {
     ++stats_.waits;
   }
   detection_task_.collect();
-  stats_.last_detection_ms = detection_task_.lastMilliseconds();
   return decide(detect_slot_, found_, map);
 }
 

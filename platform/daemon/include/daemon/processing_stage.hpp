@@ -40,7 +40,6 @@ class ProcessingStage {
 
   uint64_t processed() const { return processed_.load(std::memory_order_relaxed); }
   uint64_t poseDrops() const { return pose_drops_.load(std::memory_order_relaxed); }
-  uint64_t waiting() const { return runner_.waiting(); }  // prepared, not yet finished
   // Frames taken from the rig ring and not yet processed (being prepared, waiting, being finished).
   uint64_t inFlight() const {
     return taken_.load(std::memory_order_relaxed) - processed_.load(std::memory_order_relaxed);

@@ -31,7 +31,6 @@ struct LoopStats {
   int64_t last_keyframe = -1, last_candidate = -1;  // place keyframe ids of the last closure
   double last_correction_m = 0, last_correction_deg = 0;
   double last_solve_ms = 0;
-  double last_detection_ms = 0;  // the last keyframe's query and verification, on the detection thread
 };
 
 // The map file's loops part: the loops, then each of the map's segments' root (which segment the loops joined it
@@ -45,14 +44,13 @@ class LoopCloser {
  public:
   LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera);
 
-  // The extrinsics the next detection projects with. Not while detecting().
+  // The extrinsics the next detection projects with. Not while a detection is in flight.
   void setRig(const Rig& rig) { verifier_.setRig(rig); }
   // Keyframe `slot` was just added to `map`, with its words to `database` (`features`: the frame it was made of):
   // starts looking for a loop it closes on the detection thread (copying `features` and `words`). Until
-  // collectDetection() took the result, `map` and `database` must not be written. Not while detecting().
+  // collectDetection() took the result, `map` and `database` must not be written, nor another detection started.
   void startDetection(int slot, const FrameFeatures& features, const FrameWords& words, const PlaceMap& map,
                       const PlaceDatabase& database);
-  bool detecting() const { return detection_task_.running(); }
   // Takes the result of the detection in flight, waiting for it with `wait` (otherwise only when it is ready), and
   // decides on it: true when it closed a loop, whose correction is then being solved; the map does not move until
   // takeCorrection(). `map` is the one the detection started on, unchanged.
