@@ -7,29 +7,29 @@ namespace mcslam::backend {
 
 namespace {
 
-// ad(xi) of se(3) in [rho; phi] order: [phi^ rho^; 0 phi^].
-Mat6 smallAdjoint(const Vec6& xi) {
-  Mat6 ad = Mat6::Zero();
-  ad.topLeftCorner<3, 3>() = hat(xi.tail<3>());
-  ad.topRightCorner<3, 3>() = hat(xi.head<3>());
-  ad.bottomRightCorner<3, 3>() = hat(xi.tail<3>());
-  return ad;
+// Inverse right Jacobian to second order: exact enough for the residuals a pose graph meets (a loop closure's
+// first residual included: the linearization is redone at every step).
+template <class Pose>
+typename Pose::Jacobian rightJacobianInverse(const typename Pose::Tangent& r) {
+  return Pose::Jacobian::Identity() + 0.5 * Pose::smallAdjoint(r);
 }
 
-// Inverse right Jacobian of SE(3) to second order: exact enough for the residuals a pose graph meets (a loop
-// closure's first residual included: the linearization is redone at every step).
-Mat6 rightJacobianInverse(const Vec6& r) { return Mat6::Identity() + 0.5 * smallAdjoint(r); }
-
-Vec6 edgeError(const SE3& inverse_measurement, const SE3& T_a, const SE3& T_b) {
+template <class Pose>
+typename Pose::Tangent edgeError(const Pose& inverse_measurement, const Pose& T_a, const Pose& T_b) {
   return (inverse_measurement * T_a.inverse() * T_b).log();
 }
 
 }  // namespace
 
 // The least-squares problem over the free nodes: variable v is node node_of_[v].
-class PoseGraph::Problem final : public LeastSquaresProblem {
+template <class Pose>
+class PoseGraphT<Pose>::Problem final : public LeastSquaresProblem {
+  static constexpr int D = Pose::kDof;
+  using Tangent = typename Pose::Tangent;
+  using Jacobian = typename Pose::Jacobian;
+
  public:
-  Problem(PoseGraph& graph, int max_nodes, int max_edges)
+  Problem(PoseGraphT& graph, int max_nodes, int max_edges)
       : graph_(graph),
         solver_(max_nodes, max_edges),
         variable_of_(static_cast<std::size_t>(max_nodes)),
@@ -38,9 +38,9 @@ class PoseGraph::Problem final : public LeastSquaresProblem {
         pair_of_edge_(static_cast<std::size_t>(max_edges), -1),
         entry_of_pair_(static_cast<std::size_t>(max_edges)),
         undamped_(static_cast<std::size_t>(max_nodes)),
-        g_(static_cast<std::size_t>(6 * max_nodes)),
-        dx_(static_cast<std::size_t>(6 * max_nodes)),
-        rhs_(static_cast<std::size_t>(6 * max_nodes)),
+        g_(static_cast<std::size_t>(D * max_nodes)),
+        dx_(static_cast<std::size_t>(D * max_nodes)),
+        rhs_(static_cast<std::size_t>(D * max_nodes)),
         trial_(static_cast<std::size_t>(max_nodes)) {}
 
   // Variables and the block structure of the current graph; false when nothing is free.
@@ -66,27 +66,27 @@ class PoseGraph::Problem final : public LeastSquaresProblem {
 
   bool linearize() override {
     solver_.setZero();
-    std::fill(g_.begin(), g_.begin() + 6 * variables_, 0.0);
+    std::fill(g_.begin(), g_.begin() + D * variables_, 0.0);
     cost_ = 0;
     for (int e = 0; e < graph_.edges_; ++e) {
       const auto se = static_cast<std::size_t>(e);
       const int a = graph_.edge_a_[se], b = graph_.edge_b_[se];
       const int va = variable_of_[static_cast<std::size_t>(a)], vb = variable_of_[static_cast<std::size_t>(b)];
-      const SE3& T_a = graph_.pose(a);
-      const SE3& T_b = graph_.pose(b);
-      const Vec6 r = edgeError(graph_.edge_inverse_measurement_[se], T_a, T_b);
-      const Vec6& w = graph_.edge_weight_[se];
-      const Vec6 wr = w.cwiseProduct(r);
+      const Pose& T_a = graph_.pose(a);
+      const Pose& T_b = graph_.pose(b);
+      const Tangent r = edgeError(graph_.edge_inverse_measurement_[se], T_a, T_b);
+      const Tangent& w = graph_.edge_weight_[se];
+      const Tangent wr = w.cwiseProduct(r);
       cost_ += 0.5 * wr.squaredNorm();
       if (va < 0 && vb < 0) continue;
-      const Mat6 Jb = w.asDiagonal() * rightJacobianInverse(r);
-      const Mat6 Ja = -Jb * (T_b.inverse() * T_a).adjoint();
+      const Jacobian Jb = w.asDiagonal() * rightJacobianInverse<Pose>(r);
+      const Jacobian Ja = -Jb * (T_b.inverse() * T_a).adjoint();
       if (va >= 0) addBlock(va, Ja, wr);
       if (vb >= 0) addBlock(vb, Jb, wr);
       if (va >= 0 && vb >= 0 && va != vb) {
         const int entry = entry_of_pair_[static_cast<std::size_t>(pair_of_edge_[se])];
         const bool a_low = solver_.entryLow(entry) == va;
-        solver_.offDiagonal(entry) += a_low ? Mat6(Ja.transpose() * Jb) : Mat6(Jb.transpose() * Ja);
+        solver_.offDiagonal(entry) += a_low ? Jacobian(Ja.transpose() * Jb) : Jacobian(Jb.transpose() * Ja);
       }
     }
     for (int v = 0; v < variables_; ++v) undamped_[static_cast<std::size_t>(v)] = solver_.diagonal(v);
@@ -98,29 +98,29 @@ class PoseGraph::Problem final : public LeastSquaresProblem {
   void buildDampedSystem(double mu) override {
     mu_ = mu;
     for (int v = 0; v < variables_; ++v) {
-      Mat6& D = solver_.diagonal(v);
-      D = undamped_[static_cast<std::size_t>(v)];
-      for (int k = 0; k < 6; ++k) D(k, k) += mu * dampingDiagonal(D(k, k));
+      Jacobian& H = solver_.diagonal(v);
+      H = undamped_[static_cast<std::size_t>(v)];
+      for (int k = 0; k < D; ++k) H(k, k) += mu * dampingDiagonal(H(k, k));
     }
   }
 
   double maxGradient() const override {
     double m = 0;
-    for (int i = 0; i < 6 * variables_; ++i) m = std::max(m, std::abs(g_[static_cast<std::size_t>(i)]));
+    for (int i = 0; i < D * variables_; ++i) m = std::max(m, std::abs(g_[static_cast<std::size_t>(i)]));
     return m;
   }
 
   bool solveStep() override {
-    for (int i = 0; i < 6 * variables_; ++i) rhs_[static_cast<std::size_t>(i)] = -g_[static_cast<std::size_t>(i)];
+    for (int i = 0; i < D * variables_; ++i) rhs_[static_cast<std::size_t>(i)] = -g_[static_cast<std::size_t>(i)];
     if (!solver_.solve(rhs_.data(), dx_.data())) return false;
-    for (int i = 0; i < 6 * variables_; ++i)
+    for (int i = 0; i < D * variables_; ++i)
       if (!std::isfinite(dx_[static_cast<std::size_t>(i)])) return false;
     return true;
   }
 
   double stepNorm() const override {
     double s = 0;
-    for (int i = 0; i < 6 * variables_; ++i) s += dx_[static_cast<std::size_t>(i)] * dx_[static_cast<std::size_t>(i)];
+    for (int i = 0; i < D * variables_; ++i) s += dx_[static_cast<std::size_t>(i)] * dx_[static_cast<std::size_t>(i)];
     return std::sqrt(s);
   }
 
@@ -128,9 +128,9 @@ class PoseGraph::Problem final : public LeastSquaresProblem {
   double modelCostDecrease(double mu) const override {
     double gdx = 0, ddx = 0;
     for (int v = 0; v < variables_; ++v) {
-      const Mat6& H = undamped_[static_cast<std::size_t>(v)];
-      for (int k = 0; k < 6; ++k) {
-        const auto i = static_cast<std::size_t>(6 * v + k);
+      const Jacobian& H = undamped_[static_cast<std::size_t>(v)];
+      for (int k = 0; k < D; ++k) {
+        const auto i = static_cast<std::size_t>(D * v + k);
         gdx += g_[i] * dx_[i];
         ddx += dampingDiagonal(H(k, k)) * dx_[i] * dx_[i];
       }
@@ -140,14 +140,14 @@ class PoseGraph::Problem final : public LeastSquaresProblem {
 
   bool evaluateTrial(double& cost) override {
     for (int v = 0; v < variables_; ++v) {
-      Vec6 step;
-      for (int k = 0; k < 6; ++k) step[k] = dx_[static_cast<std::size_t>(6 * v + k)];
-      trial_[static_cast<std::size_t>(v)] = graph_.pose(node_of_[static_cast<std::size_t>(v)]) * SE3::exp(step);
+      Tangent step;
+      for (int k = 0; k < D; ++k) step[k] = dx_[static_cast<std::size_t>(D * v + k)];
+      trial_[static_cast<std::size_t>(v)] = graph_.pose(node_of_[static_cast<std::size_t>(v)]) * Pose::exp(step);
     }
     cost = 0;
     for (int e = 0; e < graph_.edges_; ++e) {
       const auto se = static_cast<std::size_t>(e);
-      const Vec6 r =
+      const Tangent r =
           edgeError(graph_.edge_inverse_measurement_[se], trialPose(graph_.edge_a_[se]), trialPose(graph_.edge_b_[se]));
       cost += 0.5 * graph_.edge_weight_[se].cwiseProduct(r).squaredNorm();
     }
@@ -156,7 +156,7 @@ class PoseGraph::Problem final : public LeastSquaresProblem {
 
   void acceptTrial() override {
     for (int v = 0; v < variables_; ++v) {
-      SE3& T = graph_.poses_[static_cast<std::size_t>(node_of_[static_cast<std::size_t>(v)])];
+      Pose& T = graph_.poses_[static_cast<std::size_t>(node_of_[static_cast<std::size_t>(v)])];
       T = trial_[static_cast<std::size_t>(v)];
       T.normalize();
     }
@@ -165,29 +165,30 @@ class PoseGraph::Problem final : public LeastSquaresProblem {
   int analyses() const { return solver_.analyses(); }
 
  private:
-  void addBlock(int v, const Mat6& J, const Vec6& wr) {
+  void addBlock(int v, const Jacobian& J, const Tangent& wr) {
     solver_.diagonal(v) += J.transpose() * J;
-    const Vec6 gv = J.transpose() * wr;
-    for (int k = 0; k < 6; ++k) g_[static_cast<std::size_t>(6 * v + k)] += gv[k];
+    const Tangent gv = J.transpose() * wr;
+    for (int k = 0; k < D; ++k) g_[static_cast<std::size_t>(D * v + k)] += gv[k];
   }
-  const SE3& trialPose(int node) const {
+  const Pose& trialPose(int node) const {
     const int v = variable_of_[static_cast<std::size_t>(node)];
     return v < 0 ? graph_.pose(node) : trial_[static_cast<std::size_t>(v)];
   }
 
-  PoseGraph& graph_;
-  SparseBlockSolver solver_;
+  PoseGraphT& graph_;
+  SparseBlockSolver<D> solver_;
   std::vector<int32_t> variable_of_, node_of_;
   std::vector<BlockPair> pairs_;
   std::vector<int32_t> pair_of_edge_, entry_of_pair_;
-  std::vector<Mat6> undamped_;
+  std::vector<Jacobian> undamped_;
   std::vector<double> g_, dx_, rhs_;
-  std::vector<SE3> trial_;
+  std::vector<Pose> trial_;
   int variables_ = 0;
   double cost_ = 0, mu_ = 0;
 };
 
-PoseGraph::PoseGraph(int max_nodes, int max_edges)
+template <class Pose>
+PoseGraphT<Pose>::PoseGraphT(int max_nodes, int max_edges)
     : poses_(static_cast<std::size_t>(max_nodes)),
       fixed_(static_cast<std::size_t>(max_nodes), 0),
       edge_a_(static_cast<std::size_t>(max_edges)),
@@ -196,18 +197,24 @@ PoseGraph::PoseGraph(int max_nodes, int max_edges)
       edge_weight_(static_cast<std::size_t>(max_edges)),
       problem_(std::make_unique<Problem>(*this, max_nodes, max_edges)) {}
 
-PoseGraph::~PoseGraph() = default;
+template <class Pose>
+PoseGraphT<Pose>::~PoseGraphT() = default;
 
-void PoseGraph::clear() { nodes_ = edges_ = 0; }
+template <class Pose>
+void PoseGraphT<Pose>::clear() {
+  nodes_ = edges_ = 0;
+}
 
-int PoseGraph::addNode(const SE3& T_w_n, bool fixed) {
+template <class Pose>
+int PoseGraphT<Pose>::addNode(const Pose& T_w_n, bool fixed) {
   if (nodes_ == maxNodes()) return -1;
   poses_[static_cast<std::size_t>(nodes_)] = T_w_n;
   fixed_[static_cast<std::size_t>(nodes_)] = fixed ? 1 : 0;
   return nodes_++;
 }
 
-bool PoseGraph::addEdge(int a, int b, const SE3& T_a_b, const Vec6& sigma) {
+template <class Pose>
+bool PoseGraphT<Pose>::addEdge(int a, int b, const Pose& T_a_b, const Tangent& sigma) {
   if (edges_ == maxEdges() || a < 0 || b < 0 || a >= nodes_ || b >= nodes_) return false;
   const auto e = static_cast<std::size_t>(edges_++);
   edge_a_[e] = a;
@@ -217,14 +224,19 @@ bool PoseGraph::addEdge(int a, int b, const SE3& T_a_b, const Vec6& sigma) {
   return true;
 }
 
-void PoseGraph::setFixed(int n, bool fixed) { fixed_[static_cast<std::size_t>(n)] = fixed ? 1 : 0; }
+template <class Pose>
+void PoseGraphT<Pose>::setFixed(int n, bool fixed) {
+  fixed_[static_cast<std::size_t>(n)] = fixed ? 1 : 0;
+}
 
-Vec6 PoseGraph::residual(int e) const {
+template <class Pose>
+typename PoseGraphT<Pose>::Tangent PoseGraphT<Pose>::residual(int e) const {
   const auto se = static_cast<std::size_t>(e);
   return edge_weight_[se].cwiseProduct(edgeError(edge_inverse_measurement_[se], pose(edge_a_[se]), pose(edge_b_[se])));
 }
 
-PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
+template <class Pose>
+PoseGraphSummary PoseGraphT<Pose>::optimize(const PoseGraphOptions& options) {
   PoseGraphSummary summary;
   if (!problem_->setUp()) return summary;
   LoopOptions loop;
@@ -241,5 +253,8 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
   summary.analyses = problem_->analyses();
   return summary;
 }
+
+template class PoseGraphT<SE3>;
+template class PoseGraphT<Sim3>;
 
 }  // namespace mcslam::backend

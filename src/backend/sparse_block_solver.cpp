@@ -8,24 +8,26 @@ namespace mcslam::backend {
 
 namespace {
 
-// Nonzeros of the upper triangle: 21 per diagonal block, 36 per off-diagonal one.
-std::size_t upperNonzeros(int blocks, int pairs) {
-  return std::size_t{21} * static_cast<std::size_t>(blocks) + std::size_t{36} * static_cast<std::size_t>(pairs);
+// Nonzeros of the upper triangle: N (N + 1) / 2 per diagonal block, N^2 per off-diagonal one.
+std::size_t upperNonzeros(int n, int blocks, int pairs) {
+  const auto block = static_cast<std::size_t>(n);
+  return block * (block + 1) / 2 * static_cast<std::size_t>(blocks) + block * block * static_cast<std::size_t>(pairs);
 }
 
 // CHOLMOD's peak for a pose graph: the factor (AMD keeps a chain with loops at a few times the matrix's nonzeros),
 // the matrix's permuted copy, AMD's workspace, the solve's vectors; the fixed part covers Common's workspace.
-std::size_t arenaBytes(int blocks, int pairs) {
-  return (std::size_t{1} << 20) + 160 * upperNonzeros(blocks, pairs) +
+std::size_t arenaBytes(int n, int blocks, int pairs) {
+  return (std::size_t{1} << 20) + 160 * upperNonzeros(n, blocks, pairs) +
          std::size_t{1024} * static_cast<std::size_t>(blocks);
 }
 
 }  // namespace
 
-SparseBlockSolver::SparseBlockSolver(int max_blocks, int max_pairs)
+template <int N>
+SparseBlockSolver<N>::SparseBlockSolver(int max_blocks, int max_pairs)
     : max_blocks_(max_blocks),
       max_pairs_(max_pairs),
-      arena_(arenaBytes(max_blocks, max_pairs)),
+      arena_(arenaBytes(N, max_blocks, max_pairs)),
       diagonal_(static_cast<std::size_t>(max_blocks)),
       off_(static_cast<std::size_t>(max_pairs)),
       keys_(static_cast<std::size_t>(max_pairs)),
@@ -42,13 +44,14 @@ SparseBlockSolver::SparseBlockSolver(int max_blocks, int max_pairs)
   common_.final_ll = 1;
   common_.nmethods = 1;
   common_.method[0].ordering = CHOLMOD_AMD;
-  A_ = cholmod_allocate_sparse(n, n, upperNonzeros(max_blocks, max_pairs), /*sorted=*/1, /*packed=*/1, /*stype=*/1,
+  A_ = cholmod_allocate_sparse(n, n, upperNonzeros(N, max_blocks, max_pairs), /*sorted=*/1, /*packed=*/1, /*stype=*/1,
                                CHOLMOD_REAL, &common_);
   B_ = cholmod_allocate_dense(n, 1, n, CHOLMOD_REAL, &common_);
   if (!A_ || !B_) throw std::runtime_error("SparseBlockSolver: CHOLMOD allocation failed");
 }
 
-SparseBlockSolver::~SparseBlockSolver() {
+template <int N>
+SparseBlockSolver<N>::~SparseBlockSolver() {
   ArenaScope scope(arena_);
   cholmod_free_factor(&L_, &common_);
   cholmod_free_sparse(&A_, &common_);
@@ -59,8 +62,9 @@ SparseBlockSolver::~SparseBlockSolver() {
   cholmod_finish(&common_);
 }
 
-bool SparseBlockSolver::setStructure(int num_blocks, std::span<const BlockPair> pairs,
-                                     std::span<int32_t> entry_of_pair) {
+template <int N>
+bool SparseBlockSolver<N>::setStructure(int num_blocks, std::span<const BlockPair> pairs,
+                                        std::span<int32_t> entry_of_pair) {
   if (num_blocks > max_blocks_ || static_cast<int>(pairs.size()) > max_pairs_)
     throw std::logic_error("SparseBlockSolver: structure beyond the capacity");
   const auto key = [this](const BlockPair& p) {
@@ -96,7 +100,8 @@ bool SparseBlockSolver::setStructure(int num_blocks, std::span<const BlockPair> 
   return true;
 }
 
-void SparseBlockSolver::buildPattern() {
+template <int N>
+void SparseBlockSolver<N>::buildPattern() {
   // Entries are sorted by their high variable (the block column), then the low one (the block row).
   int e = 0;
   for (int b = 0; b <= num_blocks_; ++b) {
@@ -120,19 +125,21 @@ void SparseBlockSolver::buildPattern() {
   A_->nrow = A_->ncol = static_cast<std::size_t>(kBlock * num_blocks_);
 }
 
-void SparseBlockSolver::setZero() {
+template <int N>
+void SparseBlockSolver<N>::setZero() {
   for (int v = 0; v < num_blocks_; ++v) diagonal_[static_cast<std::size_t>(v)].setZero();
   for (int e = 0; e < entries_; ++e) off_[static_cast<std::size_t>(e)].setZero();
 }
 
-bool SparseBlockSolver::solve(const double* rhs, double* x) {
+template <int N>
+bool SparseBlockSolver<N>::solve(const double* rhs, double* x) {
   if (!L_ || num_blocks_ <= 0) return false;
   auto* Ax = static_cast<double*>(A_->x);
   int k = 0;
   for (int b = 0; b < num_blocks_; ++b) {
     const int first = first_entry_of_column_[static_cast<std::size_t>(b)];
     const int last = first_entry_of_column_[static_cast<std::size_t>(b) + 1];
-    const Mat6& D = diagonal_[static_cast<std::size_t>(b)];
+    const Block& D = diagonal_[static_cast<std::size_t>(b)];
     for (int c = 0; c < kBlock; ++c) {
       for (int entry = first; entry < last; ++entry)
         for (int r = 0; r < kBlock; ++r) Ax[k++] = off_[static_cast<std::size_t>(entry)](r, c);
@@ -150,5 +157,8 @@ bool SparseBlockSolver::solve(const double* rhs, double* x) {
   std::memcpy(x, X_->x, sizeof(double) * static_cast<std::size_t>(n));
   return true;
 }
+
+template class SparseBlockSolver<6>;
+template class SparseBlockSolver<7>;
 
 }  // namespace mcslam::backend

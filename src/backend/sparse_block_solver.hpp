@@ -1,9 +1,10 @@
 #pragma once
-// CHOLMOD solve of a sparse symmetric system of 6x6 blocks: a diagonal block per variable and off-diagonal blocks
-// where two variables share a term (the pose graph's edges). The structure goes in through setStructure(), which
-// reruns the symbolic analysis only when it differs from the last one; solve() is a numeric factorization and
-// two triangular solves. Every buffer, and all of CHOLMOD's memory (a CholmodArena), is sized at construction
-// from the most blocks and off-diagonal blocks; nothing is allocated afterwards while the arena suffices.
+// CHOLMOD solve of a sparse symmetric system of NxN blocks (6 for SE(3) poses, 7 for Sim(3)): a diagonal block per
+// variable and off-diagonal blocks where two variables share a term (the pose graph's edges). The structure goes in
+// through setStructure(), which reruns the symbolic analysis only when it differs from the last one; solve() is a
+// numeric factorization and two triangular solves. Every buffer, and all of CHOLMOD's memory (a CholmodArena), is sized
+// at construction from the most blocks and off-diagonal blocks; nothing is allocated afterwards while the arena
+// suffices.
 #include <cholmod.h>
 
 #include <cstdint>
@@ -19,9 +20,11 @@ struct BlockPair {
   int32_t a = 0, b = 0;  // variables, a != b, either order
 };
 
+template <int N>
 class SparseBlockSolver {
  public:
-  static constexpr int kBlock = 6;
+  static constexpr int kBlock = N;
+  using Block = Eigen::Matrix<double, N, N>;
 
   SparseBlockSolver(int max_blocks, int max_pairs);
   ~SparseBlockSolver();
@@ -35,13 +38,13 @@ class SparseBlockSolver {
 
   // The blocks to fill before solve(): diagonal(v) is H_vv; offDiagonal(e) is H_ab of entry e with a < b.
   void setZero();
-  Mat6& diagonal(int v) { return diagonal_[static_cast<std::size_t>(v)]; }
-  Mat6& offDiagonal(int e) { return off_[static_cast<std::size_t>(e)]; }
-  const Mat6& diagonal(int v) const { return diagonal_[static_cast<std::size_t>(v)]; }
+  Block& diagonal(int v) { return diagonal_[static_cast<std::size_t>(v)]; }
+  Block& offDiagonal(int e) { return off_[static_cast<std::size_t>(e)]; }
+  const Block& diagonal(int v) const { return diagonal_[static_cast<std::size_t>(v)]; }
   // The lower variable of entry e (its block row).
   int entryLow(int e) const { return entry_low_[static_cast<std::size_t>(e)]; }
 
-  // Solves H x = rhs (6 * num_blocks values each). False when H is not positive definite.
+  // Solves H x = rhs (N * num_blocks values each). False when H is not positive definite.
   bool solve(const double* rhs, double* x);
 
   int numBlocks() const { return num_blocks_; }
@@ -60,8 +63,8 @@ class SparseBlockSolver {
   cholmod_dense* X_ = nullptr;
   cholmod_dense* Y_ = nullptr;
   cholmod_dense* E_ = nullptr;
-  std::vector<Mat6> diagonal_;
-  std::vector<Mat6> off_;
+  std::vector<Block> diagonal_;
+  std::vector<Block> off_;
   // Structure: entries sorted by (high, low) variable; previous one kept to skip an unchanged analysis.
   std::vector<int64_t> keys_, previous_keys_;  // low + high * max_blocks_
   std::vector<int32_t> order_;                 // scratch: pairs sorted by key
@@ -71,5 +74,8 @@ class SparseBlockSolver {
   int num_blocks_ = -1;
   int analyses_ = 0;
 };
+
+extern template class SparseBlockSolver<6>;
+extern template class SparseBlockSolver<7>;
 
 }  // namespace mcslam::backend

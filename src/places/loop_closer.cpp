@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "pose_io.hpp"
@@ -22,15 +23,22 @@ bool LoopCloser::alone(int32_t segment) {
   return true;
 }
 
-LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera)
+LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera,
+                       bool similarity)
     : options_(options),
       verifier_(rig, options, scale_factor, max_features_per_camera),
       loops_(static_cast<std::size_t>(options.max_loops)),
       segment_root_(PlaceMap::kMaxSegments),
       roots_(PlaceMap::kMaxSegments),
-      correction_(options.max_keyframes, options.max_loops),
+      correction_(options.max_keyframes, options.max_loops, similarity),
       detect_features_(rig.size(), max_features_per_camera),
-      detect_words_(rig.size(), max_features_per_camera) {
+      detect_words_(rig.size(), max_features_per_camera),
+      features_per_camera_(max_features_per_camera) {
+  if (similarity) {
+    const auto keypoints = static_cast<std::size_t>(rig.size()) * static_cast<std::size_t>(max_features_per_camera);
+    detect_own_points_.assign(keypoints, Eigen::Vector3f::Constant(std::nanf("")));
+    scale_scratch_.resize(keypoints);
+  }
   detection_.closer = this;
   clear();
 }
@@ -44,7 +52,7 @@ void LoopCloser::clear() {
 }
 
 void LoopCloser::startDetection(int slot, const FrameFeatures& features, const FrameWords& words, const PlaceMap& map,
-                                const PlaceDatabase& database) {
+                                const PlaceDatabase& database, std::span<const Eigen::Vector3f> own_points) {
   // While the map's correction is being solved, its poses are about to move: a detection now would be measured
   // against the old ones (and find the loop just closed again).
   if (correcting()) {
@@ -58,6 +66,12 @@ void LoopCloser::startDetection(int slot, const FrameFeatures& features, const F
   detect_database_ = &database;
   detect_features_ = features;  // same capacities: no allocation
   detect_words_ = words;
+  if (similarity()) {
+    const std::size_t n = std::min(own_points.size(), detect_own_points_.size());
+    std::copy_n(own_points.begin(), n, detect_own_points_.begin());
+    std::fill(detect_own_points_.begin() + static_cast<std::ptrdiff_t>(n), detect_own_points_.end(),
+              Eigen::Vector3f::Constant(std::nanf("")));
+  }
   detection_task_.start(detection_);
 }
 
@@ -69,6 +83,12 @@ void LoopCloser::detect() {
     return other == detect_slot_ || (o.segment == k.segment && k.id - o.id < options_.loop_min_keyframes_apart);
   };
   found_ = verifier_.locate(detect_features_, detect_words_, map, *detect_database_, -1, reachable);
+  found_scale_ = LoopScale{};
+  if (found_.ok && similarity()) {
+    found_scale_ = loopScale(verifier_.inliers(), detect_own_points_, features_per_camera_, found_.T_w_b,
+                             verifier_.rig(), scale_scratch_);
+    found_.ok = found_scale_.ok;
+  }
 }
 
 bool LoopCloser::collectDetection(const PlaceMap& map, bool wait) {
@@ -94,16 +114,19 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, const PlaceMap&
   const PlaceKeyframe& k = map.keyframe(slot);
   const SE3 correction = r.T_w_b * k.T_w_k.inverse();  // moves the drifted keyframe onto the recognized place
   const int64_t candidate = map.keyframe(r.keyframe).id;
-  const bool confirmed = consistentWithLast(slot, map, correction);
+  const bool confirmed = consistentWithLast(slot, map, correction, found_scale_);
   pending_keyframe_ = k.id;
   pending_segment_ = k.segment;
   pending_candidate_ = candidate;
   pending_correction_ = correction;
+  pending_scale_ = found_scale_;
   if (!confirmed) return false;
-  // A correction within the loop measurement's own uncertainty (chi-square, 6 dof, 95%) says the map is consistent
-  // already: moving the world for it would only add the measurement's noise to every published pose.
+  // A correction within the loop measurement's own uncertainty (chi-square, 6 dof, 95%; and the scale within two
+  // of its standard deviations) says the map is consistent already: moving the world for it would only add the
+  // measurement's noise to every published pose.
   const Vec6 sigma = verifiedPoseSigma(r, options_);
-  if (withinUncertainty(correction, sigma)) {
+  const bool scale_agrees = !similarity() || std::abs(std::log(found_scale_.scale)) <= 2 * found_scale_.sigma_log_scale;
+  if (withinUncertainty(correction, sigma) && scale_agrees) {
     ++stats_.consistent;
     pending_keyframe_ = -1;
     return false;
@@ -112,8 +135,12 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, const PlaceMap&
     spdlog::warn("place memory: {} loop closures kept; no room for another (places.max_loops)", loops_.size());
     return false;
   }
-  loops_[static_cast<std::size_t>(loop_count_++)] = {candidate, k.id,
-                                                     map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b, sigma};
+  loops_[static_cast<std::size_t>(loop_count_++)] = {candidate,
+                                                     k.id,
+                                                     map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b,
+                                                     sigma,
+                                                     similarity() ? found_scale_.scale : 1.0,
+                                                     similarity() ? found_scale_.sigma_log_scale : 0.0};
   const int32_t root_k = findRoot(k.segment);
   const int32_t root_c = findRoot(map.keyframe(r.keyframe).segment);
   if (root_k != root_c) {
@@ -170,19 +197,25 @@ bool LoopCloser::closesALoop(const PlaceMap& map, int candidate, int slot) const
   return path > options_.loop_min_path_ratio * separation + options_.loop_min_path_m;
 }
 
-// The detection of the keyframe before this one (same segment) found a correction that agrees with this one.
-bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const {
+// The detection of the keyframe before this one (same segment) found a correction that agrees with this one; in
+// Sim(3), also a scale within three standard deviations of the two measurements and the odometry's unit drift
+// from one keyframe to the next.
+bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& correction,
+                                    const LoopScale& scale) const {
   const PlaceKeyframe& k = map.keyframe(slot);
   if (pending_keyframe_ < 0 || pending_segment_ != k.segment || k.previous < 0 ||
       map.keyframe(k.previous).id != pending_keyframe_)
+    return false;
+  if (similarity() && std::abs(std::log(scale.scale / pending_scale_.scale)) >
+                          3 * std::hypot(scale.sigma_log_scale, pending_scale_.sigma_log_scale, kOdometryLogScaleSigma))
     return false;
   return sameCorrection(pending_correction_, correction,
                         (k.T_w_k.t - map.keyframe(k.previous).T_w_k.t).norm() + correction.t.norm());
 }
 
-constexpr std::size_t kLoopBytes = 2 * sizeof(int64_t) + 12 * sizeof(double) + 6 * sizeof(double);
+constexpr std::size_t kLoopBytes = 2 * sizeof(int64_t) + 12 * sizeof(double) + 6 * sizeof(double) + 2 * sizeof(double);
 
-std::size_t loopFileBytes() { return kLoopBytes; }
+std::size_t loopFileBytes(bool with_scales) { return with_scales ? kLoopBytes : kLoopBytes - 2 * sizeof(double); }
 
 std::size_t LoopCloser::maxWrittenBytes() const {
   return sizeof(uint32_t) + loops_.size() * kLoopBytes + PlaceMap::kMaxSegments * sizeof(int32_t);
@@ -195,11 +228,13 @@ void putLoops(ByteWriter& out, std::span<const LoopEdge> loops, std::span<const 
     out.put<int64_t>(e.b);
     putPose(out, e.T_a_b);
     for (int k = 0; k < 6; ++k) out.put<double>(e.sigma[k]);
+    out.put<double>(e.scale);
+    out.put<double>(e.sigma_log_scale);
   }
   for (const int32_t root : roots) out.put<int32_t>(root);
 }
 
-int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span<int32_t> roots) {
+int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span<int32_t> roots, bool with_scales) {
   const auto count = in.take<uint32_t>("the loop count");
   if (count > loops.size())
     in.fail(std::to_string(count) + " loops, more than places.max_loops (" + std::to_string(loops.size()) + ")");
@@ -210,6 +245,10 @@ int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span
     e.T_a_b = takePose(in, "a loop's relative pose");
     for (int k = 0; k < 6; ++k) e.sigma[k] = in.take<double>("a loop's uncertainty");
     if (!(e.sigma.minCoeff() > 0) || !e.sigma.allFinite()) in.fail("a loop with an uncertainty that is not positive");
+    e.scale = with_scales ? in.take<double>("a loop's scale") : 1.0;
+    e.sigma_log_scale = with_scales ? in.take<double>("a loop's scale uncertainty") : 0.0;
+    if (!(e.scale > 0) || !std::isfinite(e.scale) || !(e.sigma_log_scale >= 0) || !std::isfinite(e.sigma_log_scale))
+      in.fail("a loop with a scale that is not positive");
   }
   // Joining always hangs the larger root under the smaller: a root that is not below its segment is no union.
   for (int s = 0; s < segments; ++s) {
@@ -225,9 +264,9 @@ void LoopCloser::write(ByteWriter& out, int segments) const {
            {segment_root_.data(), static_cast<std::size_t>(segments)});
 }
 
-void LoopCloser::read(ByteReader& in, int segments) {
+void LoopCloser::read(ByteReader& in, int segments, bool with_scales) {
   clear();  // before the first frame: nothing is being solved
-  loop_count_ = takeLoops(in, segments, loops_, segment_root_);
+  loop_count_ = takeLoops(in, segments, loops_, segment_root_, with_scales);
 }
 
 }  // namespace mcslam

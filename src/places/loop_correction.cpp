@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "mcslam/places/loop_scale.hpp"
+
 namespace mcslam {
 
 namespace {
@@ -18,17 +20,66 @@ Vec6 odometrySigma(const SE3& T_a_b) {
   return s;
 }
 
+// A loop's scale is measured from hundreds of point depths; no better than this, whatever their spread says.
+constexpr double kLoopLogScaleSigmaFloor = 0.005;
+
+Vec7 withScale(const Vec6& sigma, double log_scale_sigma) {
+  Vec7 s;
+  s << sigma, log_scale_sigma;
+  return s;
+}
+
+// Graph nodes and edges of either kind, from the map's SE(3) poses and the odometry's units.
+template <class Pose>
+struct Edges;
+
+template <>
+struct Edges<SE3> {
+  static SE3 node(const SE3& T_w_k) { return T_w_k; }
+  static void odometry(backend::PoseGraph& g, int a, int b, const PlaceKeyframe& ka, const PlaceKeyframe& kb) {
+    const SE3 T_a_b = ka.T_o_k.inverse() * kb.T_o_k;
+    g.addEdge(a, b, T_a_b, odometrySigma(T_a_b));
+  }
+  static void loop(backend::PoseGraph& g, int a, int b, const LoopEdge& e) { g.addEdge(a, b, e.T_a_b, e.sigma); }
+};
+
+template <>
+struct Edges<Sim3> {
+  static Sim3 node(const SE3& T_w_k) { return Sim3(T_w_k); }
+  // The odometry's motion from a to b in a's world unit; b's own unit is `kb.unit` (world per odometry).
+  static void odometry(backend::SimilarityPoseGraph& g, int a, int b, const PlaceKeyframe& ka,
+                       const PlaceKeyframe& kb) {
+    SE3 T_a_b = ka.T_o_k.inverse() * kb.T_o_k;
+    T_a_b.t *= ka.unit;
+    g.addEdge(a, b, Sim3(T_a_b, ka.unit / kb.unit), withScale(odometrySigma(T_a_b), kOdometryLogScaleSigma));
+  }
+  static void loop(backend::SimilarityPoseGraph& g, int a, int b, const LoopEdge& e) {
+    g.addEdge(a, b, Sim3(e.T_a_b, e.scale), withScale(e.sigma, std::max(e.sigma_log_scale, kLoopLogScaleSigmaFloor)));
+  }
+};
+
+SE3 rigidPart(const SE3& T) { return T; }
+SE3 rigidPart(const Sim3& S) { return S.rigid(); }
+double scaleOf(const SE3&) { return 1.0; }
+double scaleOf(const Sim3& S) { return S.s; }
+
 }  // namespace
 
-LoopCorrection::LoopCorrection(int max_keyframes, int max_loops)
-    : graph_(max_keyframes, 2 * max_keyframes + max_loops),
-      node_of_slot_(static_cast<std::size_t>(max_keyframes), -1),
+LoopCorrection::LoopCorrection(int max_keyframes, int max_loops, bool similarity)
+    : node_of_slot_(static_cast<std::size_t>(max_keyframes), -1),
       id_of_node_(static_cast<std::size_t>(max_keyframes), -1),
       nodes_by_id_(static_cast<std::size_t>(max_keyframes), -1),
       newest_node_(PlaceMap::kMaxSegments, -1),
       newest_pose_before_(PlaceMap::kMaxSegments),
       segment_delta_(PlaceMap::kMaxSegments) {
-  solve_.graph = &graph_;
+  const int max_edges = 2 * max_keyframes + max_loops;
+  if (similarity) {
+    similar_ = std::make_unique<backend::SimilarityPoseGraph>(max_keyframes, max_edges);
+    solve_.similar = similar_.get();
+  } else {
+    rigid_ = std::make_unique<backend::PoseGraph>(max_keyframes, max_edges);
+    solve_.rigid = rigid_.get();
+  }
 }
 
 int LoopCorrection::nodeOfId(int64_t id, int nodes) const {
@@ -39,7 +90,9 @@ int LoopCorrection::nodeOfId(int64_t id, int nodes) const {
   return it != end && id_of_node_[static_cast<std::size_t>(*it)] == id ? *it : -1;
 }
 
-void LoopCorrection::addLoops(std::span<const LoopEdge> loops, int nodes) {
+template <class Graph>
+void LoopCorrection::addLoops(Graph& graph, std::span<const LoopEdge> loops, int nodes) {
+  using Pose = std::decay_t<decltype(graph.pose(0))>;
   const auto end = nodes_by_id_.begin() + nodes;
   std::iota(nodes_by_id_.begin(), end, 0);
   std::sort(nodes_by_id_.begin(), end, [this](int32_t a, int32_t b) {
@@ -47,47 +100,54 @@ void LoopCorrection::addLoops(std::span<const LoopEdge> loops, int nodes) {
   });
   for (const LoopEdge& e : loops) {
     const int a = nodeOfId(e.a, nodes), b = nodeOfId(e.b, nodes);
-    if (a >= 0 && b >= 0) graph_.addEdge(a, b, e.T_a_b, e.sigma);
+    if (a >= 0 && b >= 0) Edges<Pose>::loop(graph, a, b, e);
   }
 }
 
 void LoopCorrection::start(const PlaceMap& map, std::span<const LoopEdge> loops,
                            std::span<const int32_t> root_of_segment) {
-  graph_.clear();
-  std::fill(node_of_slot_.begin(), node_of_slot_.end(), -1);
-  std::fill(newest_node_.begin(), newest_node_.end(), -1);
-  for (int slot = 0; slot < map.capacity(); ++slot) {
-    const PlaceKeyframe& k = map.keyframe(slot);
-    if (!k.alive) continue;
-    const int node = graph_.addNode(k.T_w_k, false);
-    node_of_slot_[static_cast<std::size_t>(slot)] = node;
-    id_of_node_[static_cast<std::size_t>(node)] = k.id;
-    if (k.next < 0) {
-      newest_node_[static_cast<std::size_t>(k.segment)] = node;
-      newest_pose_before_[static_cast<std::size_t>(k.segment)] = k.T_w_k;
-    }
-    if (k.previous < 0 && root_of_segment[static_cast<std::size_t>(k.segment)] == k.segment)
-      graph_.setFixed(node, true);
-  }
-  for (int slot = 0; slot < map.capacity(); ++slot) {
-    const PlaceKeyframe& k = map.keyframe(slot);
-    if (!k.alive || k.previous < 0) continue;
-    const SE3 T_a_b = map.keyframe(k.previous).T_o_k.inverse() * k.T_o_k;
-    graph_.addEdge(node_of_slot_[static_cast<std::size_t>(k.previous)], node_of_slot_[static_cast<std::size_t>(slot)],
-                   T_a_b, odometrySigma(T_a_b));
-  }
-  addLoops(loops, graph_.nodes());
+  if (rigid_) build(*rigid_, map, loops, root_of_segment);
+  if (similar_) build(*similar_, map, loops, root_of_segment);
   graph_reshapes_ = map.reshapes();
   graph_segments_ = map.segments();
   graph_next_id_ = map.nextId();
   task_.start(solve_);
 }
 
+template <class Graph>
+void LoopCorrection::build(Graph& graph, const PlaceMap& map, std::span<const LoopEdge> loops,
+                           std::span<const int32_t> root_of_segment) {
+  using Pose = std::decay_t<decltype(graph.pose(0))>;
+  graph.clear();
+  std::fill(node_of_slot_.begin(), node_of_slot_.end(), -1);
+  std::fill(newest_node_.begin(), newest_node_.end(), -1);
+  for (int slot = 0; slot < map.capacity(); ++slot) {
+    const PlaceKeyframe& k = map.keyframe(slot);
+    if (!k.alive) continue;
+    const int node = graph.addNode(Edges<Pose>::node(k.T_w_k), false);
+    node_of_slot_[static_cast<std::size_t>(slot)] = node;
+    id_of_node_[static_cast<std::size_t>(node)] = k.id;
+    if (k.next < 0) {
+      newest_node_[static_cast<std::size_t>(k.segment)] = node;
+      newest_pose_before_[static_cast<std::size_t>(k.segment)] = k.T_w_k;
+    }
+    if (k.previous < 0 && root_of_segment[static_cast<std::size_t>(k.segment)] == k.segment) graph.setFixed(node, true);
+  }
+  for (int slot = 0; slot < map.capacity(); ++slot) {
+    const PlaceKeyframe& k = map.keyframe(slot);
+    if (!k.alive || k.previous < 0) continue;
+    Edges<Pose>::odometry(graph, node_of_slot_[static_cast<std::size_t>(k.previous)],
+                          node_of_slot_[static_cast<std::size_t>(slot)], map.keyframe(k.previous), k);
+  }
+  addLoops(graph, loops, graph.nodes());
+}
+
 LoopCorrection::Outcome LoopCorrection::take(PlaceMap& map, bool wait) {
   if (!task_.running() || (!wait && !task_.ready())) return Outcome::None;
   task_.collect();
   if (map.reshapes() != graph_reshapes_) return Outcome::Stale;
-  apply(map);
+  if (rigid_) apply(*rigid_, map);
+  if (similar_) apply(*similar_, map);
   return Outcome::Applied;
 }
 
@@ -95,12 +155,14 @@ int LoopCorrection::newestNode(int32_t segment) const {
   return segment < graph_segments_ ? newest_node_[static_cast<std::size_t>(segment)] : -1;
 }
 
-void LoopCorrection::apply(PlaceMap& map) {
+template <class Graph>
+void LoopCorrection::apply(const Graph& graph, PlaceMap& map) {
+  using Pose = std::decay_t<decltype(graph.pose(0))>;
   for (int32_t s = 0; s < map.segments(); ++s) {
     const int newest = newestNode(s);
     if (newest >= 0)
       segment_delta_[static_cast<std::size_t>(s)] =
-          graph_.pose(newest) * newest_pose_before_[static_cast<std::size_t>(s)].inverse();
+          Sim3(graph.pose(newest) * Edges<Pose>::node(newest_pose_before_[static_cast<std::size_t>(s)].inverse()));
   }
   // A segment with no keyframe in the graph (begun during the solve, or without keyframes) moves with the nearest
   // segment up the chain it continues that has one; a reused segment may continue one numbered after it.
@@ -110,19 +172,22 @@ void LoopCorrection::apply(PlaceMap& map) {
     for (int hops = 0; parent >= 0 && newestNode(parent) < 0 && hops < PlaceMap::kMaxSegments; ++hops)
       parent = map.continuesFrom(parent);
     segment_delta_[static_cast<std::size_t>(s)] =
-        parent >= 0 && newestNode(parent) >= 0 ? segment_delta_[static_cast<std::size_t>(parent)] : SE3();
+        parent >= 0 && newestNode(parent) >= 0 ? segment_delta_[static_cast<std::size_t>(parent)] : Sim3();
   }
-  for (int32_t s = 0; s < map.segments(); ++s)
-    map.setSegmentPose(s, segment_delta_[static_cast<std::size_t>(s)] * map.segmentPose(s));
+  for (int32_t s = 0; s < map.segments(); ++s) {
+    const Sim3 moved = segment_delta_[static_cast<std::size_t>(s)] * map.segmentSimilarity(s);
+    map.setSegmentPose(s, moved.rigid());
+    map.setSegmentScale(s, moved.s);
+  }
   for (int slot = 0; slot < map.capacity(); ++slot) {
     const PlaceKeyframe& k = map.keyframe(slot);
     if (!k.alive) continue;
     const int node = node_of_slot_[static_cast<std::size_t>(slot)];
-    if (k.id < graph_next_id_ && node >= 0 && id_of_node_[static_cast<std::size_t>(node)] == k.id) {
-      map.setKeyframePose(slot, graph_.pose(node));
-    } else {
-      map.setKeyframePose(slot, segment_delta_[static_cast<std::size_t>(k.segment)] * k.T_w_k);
-    }
+    const bool in_graph = k.id < graph_next_id_ && node >= 0 && id_of_node_[static_cast<std::size_t>(node)] == k.id;
+    const Sim3 moved = in_graph ? Sim3(rigidPart(graph.pose(node)), scaleOf(graph.pose(node)))
+                                : segment_delta_[static_cast<std::size_t>(k.segment)] * Sim3(k.T_w_k);
+    map.setKeyframePose(slot, moved.rigid());
+    if (moved.s != 1.0) map.scaleKeyframe(slot, moved.s);
   }
 }
 

@@ -55,9 +55,9 @@ MapFileHeader openMapFile(std::string_view bytes, const std::string& name, ByteR
     throw InputError(name + ": not an mcslam map file (it does not start with 'MCSLMAP')");
   ByteReader envelope(bytes.substr(sizeof(kMagic)), name);
   const auto version = envelope.take<uint32_t>("the version");
-  if (version != MapFileHeader::kVersion)
-    throw InputError(name + ": map file version " + std::to_string(version) + ", this build reads version " +
-                     std::to_string(MapFileHeader::kVersion));
+  if (version < MapFileHeader::kOldestVersion || version > MapFileHeader::kVersion)
+    throw InputError(name + ": map file version " + std::to_string(version) + ", this build reads versions " +
+                     std::to_string(MapFileHeader::kOldestVersion) + " to " + std::to_string(MapFileHeader::kVersion));
   const auto size = envelope.take<uint64_t>("the payload size");
   const auto crc = envelope.take<uint32_t>("the checksum");
   const std::size_t actual = bytes.size() - mapEnvelopeBytes();
@@ -68,6 +68,7 @@ MapFileHeader openMapFile(std::string_view bytes, const std::string& name, ByteR
     throw InputError(name + ": checksum mismatch: the map file is corrupt");
   payload = ByteReader(bytes.substr(mapEnvelopeBytes()), name);
   MapFileHeader h;
+  h.version = version;
   const auto cameras = payload.take<uint32_t>("the camera count");
   if (cameras == 0 || cameras > 64) payload.fail("a map of " + std::to_string(cameras) + " cameras");
   h.cameras.resize(cameras);

@@ -1,7 +1,9 @@
 #include "mcslam/places/place_map.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <string>
 
 #include "pose_io.hpp"
 
@@ -14,6 +16,7 @@ PlaceMap::PlaceMap(int max_keyframes, int max_points_per_keyframe)
       max_points_(max_points_per_keyframe),
       newest_of_segment_(kMaxSegments, -1),
       segment_T_w_o_(kMaxSegments),
+      segment_scale_(kMaxSegments, 1.0),
       segment_placed_(kMaxSegments, 0),
       segment_continues_(kMaxSegments, -1),
       file_position_(static_cast<std::size_t>(max_keyframes)) {
@@ -44,6 +47,7 @@ int PlaceMap::createKeyframe(int32_t segment, Timestamp t, uint64_t frame_index,
   k.frame_index = frame_index;
   k.T_w_k = T_w_k;
   k.T_o_k = T_o_k;
+  k.unit = segment_scale_[static_cast<std::size_t>(segment)];
   int32_t& newest = newest_of_segment_[static_cast<std::size_t>(segment)];
   k.previous = newest;
   if (newest >= 0) keyframes_[static_cast<std::size_t>(newest)].next = slot;
@@ -126,14 +130,33 @@ int PlaceMap::leastNeededKeyframe(std::span<const int64_t> kept) const {
   return best;
 }
 
+void PlaceMap::scaleKeyframe(int slot, double s) {
+  PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
+  k.unit *= s;
+  PlacePoint* points = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
+  for (int i = 0; i < k.point_count; ++i) points[i].p_k *= static_cast<float>(s);
+}
+
+SE3 PlaceMap::toWorld(int32_t segment, const SE3& T_o_b) const {
+  const SE3& T_w_o = segmentPose(segment);
+  return {T_w_o.R * T_o_b.R, segmentScale(segment) * (T_w_o.R * T_o_b.t) + T_w_o.t};
+}
+
+SE3 PlaceMap::toOdometry(int32_t segment, const SE3& T_w_b) const {
+  return (segmentSimilarity(segment).inverse() * Sim3(T_w_b)).rigid();
+}
+
+SE3 PlaceMap::segmentPoseFor(int32_t segment, const SE3& T_w_b, const SE3& T_o_b) const {
+  return (Sim3(T_w_b, segmentScale(segment)) * Sim3(T_o_b).inverse()).rigid();
+}
+
 void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {
   ++reshapes_;
-  const SE3& T_w_o = segment_T_w_o_[static_cast<std::size_t>(segment)];
   for (int slot = 0; slot < capacity(); ++slot) {
     PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
     if (!k.alive || k.segment != segment) continue;
     k.T_o_k.t = center + s * (k.T_o_k.t - center);
-    k.T_w_k = T_w_o * k.T_o_k;
+    k.T_w_k = toWorld(segment, k.T_o_k);
     PlacePoint* points = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
     for (int i = 0; i < k.point_count; ++i) points[i].p_k *= static_cast<float>(s);
   }
@@ -154,6 +177,7 @@ void PlaceMap::reuseSegment(int32_t segment, const SE3& T_w_o, bool placed, int3
 void PlaceMap::setUpSegment(int32_t segment, const SE3& T_w_o, bool placed, int32_t continues) {
   const auto s = static_cast<std::size_t>(segment);
   segment_T_w_o_[s] = T_w_o;
+  segment_scale_[s] = 1.0;
   segment_placed_[s] = placed ? 1 : 0;
   segment_continues_[s] = continues;
 }
@@ -162,7 +186,7 @@ void PlaceMap::moveSegment(int32_t segment, const SE3& T_w_o) {
   ++reshapes_;
   segment_T_w_o_[static_cast<std::size_t>(segment)] = T_w_o;
   for (PlaceKeyframe& k : keyframes_)
-    if (k.alive && k.segment == segment) k.T_w_k = T_w_o * k.T_o_k;
+    if (k.alive && k.segment == segment) k.T_w_k = toWorld(segment, k.T_o_k);
 }
 
 namespace {
@@ -171,15 +195,18 @@ constexpr std::size_t kPoseBytes = 12 * sizeof(double);
 constexpr std::size_t kPointBytes =
     3 * sizeof(float) + sizeof(int32_t) + sizeof(int16_t) + sizeof(int8_t) + sizeof(int64_t) + sizeof(Descriptor);
 constexpr std::size_t kKeyframeBytes = sizeof(int64_t) + sizeof(int32_t) + sizeof(int64_t) + sizeof(uint64_t) +
-                                       2 * kPoseBytes + 2 * sizeof(int32_t) + sizeof(uint32_t);
+                                       2 * kPoseBytes + sizeof(double) + 2 * sizeof(int32_t) + sizeof(uint32_t);
+constexpr std::size_t kSegmentBytes = kPoseBytes + sizeof(double) + 1;
 
 }  // namespace
 
-std::size_t PlaceMap::keyframeFileBytes() { return kKeyframeBytes; }
+std::size_t PlaceMap::keyframeFileBytes(bool with_scales) {
+  return with_scales ? kKeyframeBytes : kKeyframeBytes - sizeof(double);
+}
 std::size_t PlaceMap::pointFileBytes() { return kPointBytes; }
 
 std::size_t PlaceMap::maxWrittenBytes() const {
-  return sizeof(int64_t) + sizeof(uint32_t) + kMaxSegments * (kPoseBytes + 1) + sizeof(uint32_t) +
+  return sizeof(int64_t) + sizeof(uint32_t) + kMaxSegments * kSegmentBytes + sizeof(uint32_t) +
          static_cast<std::size_t>(capacity()) * (kKeyframeBytes + static_cast<std::size_t>(max_points_) * kPointBytes);
 }
 
@@ -188,6 +215,7 @@ void PlaceMap::write(ByteWriter& out) const {
   out.put<uint32_t>(static_cast<uint32_t>(segment_count_));
   for (int s = 0; s < segment_count_; ++s) {
     putPose(out, segment_T_w_o_[static_cast<std::size_t>(s)]);
+    out.put<double>(segment_scale_[static_cast<std::size_t>(s)]);
     out.put<uint8_t>(segment_placed_[static_cast<std::size_t>(s)]);
   }
   // Links as positions in the file: the reader puts the i-th keyframe written into slot i.
@@ -206,6 +234,7 @@ void PlaceMap::write(ByteWriter& out) const {
     out.put<uint64_t>(k.frame_index);
     putPose(out, k.T_w_k);
     putPose(out, k.T_o_k);
+    out.put<double>(k.unit);
     out.put<int32_t>(linked(k.previous));
     out.put<int32_t>(linked(k.next));
     out.put<uint32_t>(static_cast<uint32_t>(k.point_count));
@@ -220,7 +249,17 @@ void PlaceMap::write(ByteWriter& out) const {
   }
 }
 
-void PlaceMap::read(ByteReader& in, int cameras) {
+namespace {
+
+double takeScale(ByteReader& in, const char* what) {
+  const auto s = in.take<double>(what);
+  if (!(s > 0) || !std::isfinite(s)) in.fail(std::string(what) + " is " + std::to_string(s) + ", not a scale");
+  return s;
+}
+
+}  // namespace
+
+void PlaceMap::read(ByteReader& in, int cameras, bool with_scales) {
   clear();
   next_id_ = in.take<int64_t>("the next keyframe id");
   const auto segments = in.take<uint32_t>("the segment count");
@@ -230,6 +269,7 @@ void PlaceMap::read(ByteReader& in, int cameras) {
   segment_count_ = static_cast<int>(segments);
   for (int s = 0; s < segment_count_; ++s) {
     segment_T_w_o_[static_cast<std::size_t>(s)] = takePose(in, "a segment's pose");
+    segment_scale_[static_cast<std::size_t>(s)] = with_scales ? takeScale(in, "a segment's scale") : 1.0;
     segment_placed_[static_cast<std::size_t>(s)] = in.take<uint8_t>("a segment's placement") != 0 ? 1 : 0;
   }
   const auto count = in.take<uint32_t>("the keyframe count");
@@ -245,6 +285,7 @@ void PlaceMap::read(ByteReader& in, int cameras) {
     k.frame_index = in.take<uint64_t>("a keyframe's frame");
     k.T_w_k = takePose(in, "a keyframe's world pose");
     k.T_o_k = takePose(in, "a keyframe's odometry pose");
+    k.unit = with_scales ? takeScale(in, "a keyframe's unit") : 1.0;
     k.previous = in.take<int32_t>("a keyframe's predecessor");
     k.next = in.take<int32_t>("a keyframe's successor");
     const auto points = in.take<uint32_t>("a keyframe's point count");

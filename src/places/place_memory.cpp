@@ -15,15 +15,19 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       database_(vocabulary.wordCount(), options.max_keyframes, options.max_words_per_keyframe),
       words_(rig.size(), max_features_per_camera),
       relocalizer_(rig, options, odometry_options.scale_factor, max_features_per_camera),
-      loop_closer_(rig, options, odometry_options.scale_factor, max_features_per_camera),
+      // One camera's maps never have a metric unit: its loops are similarities.
+      loop_closer_(rig, options, odometry_options.scale_factor, max_features_per_camera, rig.size() == 1),
       seeds_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
       landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1),
+      features_per_camera_(max_features_per_camera),
       file_words_(options.max_words_per_keyframe),
       kept_ids_(2 * static_cast<std::size_t>(options.max_loops)),
       anchored_(PlaceMap::kMaxSegments, 0),
       root_placed_(PlaceMap::kMaxSegments),
       root_anchored_(PlaceMap::kMaxSegments),
       vocabulary_fingerprint_(vocabularyFingerprint(vocabulary)) {
+  if (loop_closer_.similarity())
+    own_points_.resize(static_cast<std::size_t>(rig.size()) * static_cast<std::size_t>(max_features_per_camera));
   for (int c = 0; c < rig.size(); ++c)
     cameras_.push_back({static_cast<uint32_t>(rig.model(c).width()), static_cast<uint32_t>(rig.model(c).height())});
   file_header_.cameras = cameras_;
@@ -55,7 +59,7 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   }
   if (out.valid && segment_ >= 0) {
     if (map_.placed(segment_)) {
-      out.T_w_b = map_.segmentPose(segment_) * out.T_w_b;
+      out.T_w_b = map_.toWorld(segment_, out.T_w_b);
     } else {
       out.valid = false;
       out.state = TrackingState::Localizing;
@@ -72,6 +76,7 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
   if (odometry.stats().initializations == initializations_seen_) return;
   initializations_seen_ = odometry.stats().initializations;
   const SE3 T_w_o = segment_ >= 0 ? map_.segmentPose(segment_) : SE3();
+  const double scale = segment_ >= 0 ? map_.segmentScale(segment_) : 1.0;
   // The first map of a run that reuses a saved one is nowhere in it until recognized.
   const bool placed = segment_ >= 0 ? map_.placed(segment_) : !loaded_;
   int32_t s = map_.createSegment(T_w_o, placed, segment_);
@@ -81,6 +86,7 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
                  PlaceMap::kMaxSegments);
     return;
   }
+  map_.setSegmentScale(s, scale);
   // The run's first map defines the world; a later one is where the motion model left the rig.
   anchored_[static_cast<std::size_t>(s)] = segment_ < 0 && !loaded_ ? 1 : 0;
   segment_ = s;
@@ -112,7 +118,8 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   collectLoopDetection(/*wait=*/true);  // the frame's keyframe before this one started one
   const Map& local = odometry.map();
   const Keyframe& kf = local.keyframe(odometry_slot);
-  const SE3 T_w_k = map_.segmentPose(segment_) * kf.T_w_b;
+  const SE3 T_w_k = map_.toWorld(segment_, kf.T_w_b);
+  const double unit = map_.segmentScale(segment_);  // the place map's points are in the world's unit
   if (map_.size() == map_.capacity()) makeRoom();
   const int slot = map_.createKeyframe(segment_, kf.t, kf.frame_index, T_w_k, kf.T_w_b);
   if (slot < 0) {
@@ -121,6 +128,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   }
   const SE3 T_k_o = kf.T_w_b.inverse();
   const int levels_up = words_.directLevelsUp();
+  std::fill(own_points_.begin(), own_points_.end(), Eigen::Vector3f::Constant(std::nanf("")));
   for (int c = 0; c < kf.features.cameras(); ++c) {
     const auto& landmark_of = kf.landmark_of[static_cast<std::size_t>(c)];
     for (int k = 0; k < kf.features.sets[static_cast<std::size_t>(c)].count; ++k) {
@@ -133,7 +141,8 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
       // mapper's acceptance bound on its depth.
       if (!l.metric && local.observingKeyframes(lm) < 3) continue;
       PlacePoint p;
-      p.p_k = (T_k_o * l.p_w).cast<float>();
+      p.p_k = (unit * (T_k_o * l.p_w)).cast<float>();
+      if (!own_points_.empty()) own_points_[static_cast<std::size_t>(c * features_per_camera_ + k)] = p.p_k;
       p.descriptor = l.descriptor;
       p.node = vocabulary_.ancestor(vocabulary_.word(l.descriptor), levels_up);
       p.cam = static_cast<int16_t>(c);
@@ -146,11 +155,13 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   words_.compute(vocabulary_, kf.features);
   database_.insert(slot, words_.bow());
   ++stats_.keyframes;
-  // SE(3) closures need a metric map: one whose unit is not known yet (or never will be: one camera) would need
-  // Sim(3), which is not built yet.
-  if (options_.loop_closure && odometry.rigState().metric()) {
+  // SE(3) closures need a metric map, Sim(3) ones (one camera) a unit that stays put between loops: a map of a
+  // rig without overlap whose unit is still being found waits for it.
+  const ScaleStatus scale = odometry.rigState().scale();
+  const bool closable = loop_closer_.similarity() ? scale == ScaleStatus::Monocular : scale == ScaleStatus::Metric;
+  if (options_.loop_closure && closable) {
     loop_closer_.setRig(odometry.trackingRig());
-    loop_closer_.startDetection(slot, kf.features, words_, map_, database_);
+    loop_closer_.startDetection(slot, kf.features, words_, map_, database_, own_points_);
     if (options_.repeatable) collectLoopDetection(/*wait=*/true);
   }
 }
@@ -215,20 +226,21 @@ void PlaceMemory::relocalize(const FrameFeatures& frame, uint64_t frame_index, O
 
 bool PlaceMemory::resumeOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, const SE3& T_w_b,
                                  PoseEstimate& out) {
-  // Into the current segment's odometry frame: the odometry continues in it.
-  const SE3 T_o_w = map_.segmentPose(segment_).inverse();
+  // Into the current segment's odometry frame (and unit): the odometry continues in it.
+  const Sim3 S_o_w = map_.segmentSimilarity(segment_).inverse();
   int n = 0;
   for (const PlaceMatch& m : relocalizer_.inliers()) {
     MapSeed& seed = seeds_[static_cast<std::size_t>(n++)];
     seed.cam = m.cam;
     seed.kp = m.kp;
-    seed.p_w = T_o_w * m.p_w;
+    seed.p_w = S_o_w * m.p_w;
     seed.descriptor = m.point->descriptor;
     seed.metric = true;
   }
   out.state = TrackingState::Lost;  // unless the odometry resumes
   out.valid = false;
-  odometry.relocalize(frame, frame_index, T_o_w * T_w_b, std::span(seeds_.data(), static_cast<std::size_t>(n)), out);
+  odometry.relocalize(frame, frame_index, map_.toOdometry(segment_, T_w_b),
+                      std::span(seeds_.data(), static_cast<std::size_t>(n)), out);
   return out.state == TrackingState::Tracking;
 }
 
@@ -260,7 +272,7 @@ void PlaceMemory::place(const FrameFeatures& frame, uint64_t frame_index, const 
     return;
   }
   // Two recognitions in a row must agree on where the odometry's frame lies in the map.
-  const SE3 T_w_o = r.T_w_b * T_o_b.inverse();
+  const SE3 T_w_o = map_.segmentPoseFor(segment_, r.T_w_b, T_o_b);
   const bool confirmed = pending_fix_ && sameCorrection(pending_T_w_o_, T_w_o, path_ - pending_path_);
   pending_fix_ = !confirmed;
   pending_T_w_o_ = T_w_o;
@@ -279,7 +291,7 @@ void PlaceMemory::place(const FrameFeatures& frame, uint64_t frame_index, const 
   }
   // Localizing: the odometry drifts from the map, and a recognition corrects it, when the correction is beyond the
   // recognition's own uncertainty and within what the odometry can have drifted since the last one.
-  const SE3 correction = (map_.segmentPose(segment_) * T_o_b).inverse() * r.T_w_b;  // at the body
+  const SE3 correction = map_.toWorld(segment_, T_o_b).inverse() * r.T_w_b;  // at the body
   const double travelled = path_ - path_at_fix_;
   const double angle_deg = so3Log(correction.R).norm() * 180.0 / M_PI;
   if (withinUncertainty(correction, verifiedPoseSigma(r, options_))) return;
@@ -372,7 +384,8 @@ void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool 
       h.vocabulary_fingerprint != vocabulary_fingerprint_)
     in.fail("the map was made with another vocabulary (fingerprint " + std::to_string(h.vocabulary_fingerprint) +
             ", this one's " + std::to_string(vocabulary_fingerprint_) + "): its places cannot be recognized");
-  map_.read(in, static_cast<int>(cameras_.size()));
+  const bool with_scales = h.version >= 2;
+  map_.read(in, static_cast<int>(cameras_.size()), with_scales);
   database_.clear();
   int64_t last_landmark = -1;
   for (int slot = 0; slot < map_.size(); ++slot) {
@@ -381,7 +394,7 @@ void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool 
     database_.insert(slot, file_words_);
     for (const PlacePoint& p : map_.points(slot)) last_landmark = std::max(last_landmark, p.landmark_id);
   }
-  loop_closer_.read(in, map_.segments());
+  loop_closer_.read(in, map_.segments(), with_scales);
   if (in.remaining() != 0) in.fail(std::to_string(in.remaining()) + " bytes of trailing data");
   loaded_ = true;
   std::fill(anchored_.begin(), anchored_.end(), 0);

@@ -1,6 +1,7 @@
 // The pose graph: a consistent graph stays as it is; a drifting loop closed by one edge is pulled back onto the
 // truth; the optimum is a stationary point of the true cost (no small move of any free pose lowers it); fixed
-// nodes do not move; optimizing allocates nothing, also after the graph grew.
+// nodes do not move; optimizing allocates nothing, also after the graph grew. The Sim(3) graph takes out a drift of
+// scale, which no SE(3) graph can.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -148,6 +149,142 @@ TEST(PoseGraph, OptimizingAllocatesNothingAlsoAfterTheGraphGrew) {
   const PoseGraphSummary s = g.optimize();
   EXPECT_TRUE(s.solved);
   EXPECT_EQ(s.analyses, 2);
+  EXPECT_EQ(scope.count(), 0u);
+}
+
+// A monocular odometry around the circle: its unit grows by `scale_drift` per step (a distance of 1 m near node i
+// measures (1 + scale_drift)^i map units), with a little noise.
+struct ScaleDrift {
+  std::vector<Sim3> relative;  // S_i_i+1 measured: the motion in the local unit, scale 1 (the odometry sees none)
+  std::vector<SE3> chained;    // poses by chaining them from the first
+  std::vector<double> unit;    // true map units per metre at each node
+};
+
+ScaleDrift scaleDrifting(const std::vector<SE3>& truth, double scale_drift, double noise, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n(0, noise);
+  ScaleDrift o;
+  o.chained.push_back(truth[0]);
+  o.unit.push_back(1.0);
+  for (std::size_t i = 0; i + 1 < truth.size(); ++i) {
+    SE3 rel = truth[i].inverse() * truth[i + 1];
+    rel.t *= o.unit.back();
+    Vec6 err;
+    err << n(rng), n(rng), n(rng), n(rng) * 0.1, n(rng) * 0.1, n(rng) * 0.1;
+    rel = rel * SE3::exp(err);
+    o.relative.emplace_back(rel);
+    o.chained.push_back(o.chained.back() * rel);
+    o.unit.push_back(o.unit.back() * (1 + scale_drift));
+  }
+  return o;
+}
+
+Vec7 similaritySigmas(double translation, double rotation, double log_scale) {
+  Vec7 s;
+  s << translation, translation, translation, rotation, rotation, rotation, log_scale;
+  return s;
+}
+
+// The loop edge a place recognition measures between the last node and the first: each node's local frame in its
+// own unit, so the similarity carries the ratio of the units.
+Sim3 trueSimilarity(const std::vector<SE3>& truth, const ScaleDrift& odo, std::size_t a, std::size_t b) {
+  const Sim3 S_w_a(truth[a], 1.0 / odo.unit[a]);
+  const Sim3 S_w_b(truth[b], 1.0 / odo.unit[b]);
+  return S_w_a.inverse() * S_w_b;
+}
+
+template <class Graph>
+double positionRmseOf(const Graph& g, const std::vector<SE3>& truth) {
+  double s = 0;
+  for (int i = 0; i < g.nodes(); ++i) s += (g.pose(i).t - truth[static_cast<std::size_t>(i)].t).squaredNorm();
+  return std::sqrt(s / g.nodes());
+}
+
+TEST(SimilarityPoseGraph, ALoopEdgeTakesTheScaleDriftOut) {
+  const int n = 200;
+  const auto truth = circle(n);
+  const ScaleDrift odo = scaleDrifting(truth, 0.003, 0.002, 11);  // 1.8 times the unit at the end of the loop
+  SimilarityPoseGraph sim(256, 512);
+  PoseGraph rigid(256, 512);
+  for (int i = 0; i < n; ++i) {
+    sim.addNode(Sim3(odo.chained[static_cast<std::size_t>(i)]), i == 0);
+    rigid.addNode(odo.chained[static_cast<std::size_t>(i)], i == 0);
+  }
+  for (int i = 0; i + 1 < n; ++i) {
+    const Sim3& rel = odo.relative[static_cast<std::size_t>(i)];
+    sim.addEdge(i, i + 1, rel, similaritySigmas(0.02, 0.002, 0.01));
+    rigid.addEdge(i, i + 1, rel.rigid(), sigmas(0.02, 0.002));
+  }
+  const double before = positionRmseOf(sim, truth);
+  const Sim3 loop = trueSimilarity(truth, odo, n - 1, 0);
+  sim.addEdge(n - 1, 0, loop, similaritySigmas(0.01, 0.001, 0.01));
+  rigid.addEdge(n - 1, 0, loop.rigid(), sigmas(0.01, 0.001));
+  const PoseGraphSummary s = sim.optimize();
+  ASSERT_TRUE(s.solved);
+  rigid.optimize();
+  const double after = positionRmseOf(sim, truth);
+  const double rigid_after = positionRmseOf(rigid, truth);
+  EXPECT_GT(before, 2.0);
+  EXPECT_LT(after, 0.1 * before);
+  EXPECT_LT(after, 0.25 * rigid_after);  // a rigid graph bends the loop closed but keeps the wrong unit
+  // Each node's scale took the unit it was measured in: metres per map unit.
+  for (int i = 0; i < n; i += 20)
+    EXPECT_NEAR(sim.pose(i).s * odo.unit[static_cast<std::size_t>(i)], 1.0, 0.05) << "node " << i;
+  EXPECT_EQ(sim.pose(0).s, 1.0);  // the fixed node
+}
+
+TEST(SimilarityPoseGraph, TheOptimumIsAStationaryPointOfTheCost) {
+  const int n = 60;
+  const auto truth = circle(n);
+  const ScaleDrift odo = scaleDrifting(truth, 0.01, 0.01, 13);
+  SimilarityPoseGraph g(64, 256);
+  for (int i = 0; i < n; ++i) g.addNode(Sim3(odo.chained[static_cast<std::size_t>(i)]), i == 0);
+  for (int i = 0; i + 1 < n; ++i)
+    g.addEdge(i, i + 1, odo.relative[static_cast<std::size_t>(i)], similaritySigmas(0.05, 0.01, 0.02));
+  for (int i = 0; i + 10 < n; i += 7)
+    g.addEdge(i + 10, i,
+              trueSimilarity(truth, odo, static_cast<std::size_t>(i + 10), static_cast<std::size_t>(i)) *
+                  Sim3::exp(Vec7::Constant(0.01)),
+              similaritySigmas(0.03, 0.005, 0.01));
+  PoseGraphOptions options;
+  options.max_iterations = 100;
+  options.function_tolerance = 1e-16;
+  g.optimize(options);
+  const auto cost = [&] {
+    double c = 0;
+    for (int e = 0; e < g.edges(); ++e) c += 0.5 * g.residual(e).squaredNorm();
+    return c;
+  };
+  const double optimum = cost();
+  const double h = 1e-5;
+  for (int node = 1; node < n; node += 5) {
+    for (int k = 0; k < 7; ++k) {
+      const Sim3 S = g.pose(node);
+      Vec7 d = Vec7::Zero();
+      d[k] = h;
+      g.setPose(node, S * Sim3::exp(d));
+      const double plus = cost();
+      g.setPose(node, S * Sim3::exp(-d));
+      const double minus = cost();
+      g.setPose(node, S);
+      EXPECT_LT(std::abs((plus - minus) / (2 * h)), 1e-3 * (1 + optimum)) << "node " << node << " direction " << k;
+    }
+  }
+}
+
+TEST(SimilarityPoseGraph, OptimizingAllocatesNothing) {
+  SKIP_UNLESS_COUNTING_ALLOCATIONS();
+  const int n = 200;
+  const auto truth = circle(n);
+  const ScaleDrift odo = scaleDrifting(truth, 0.003, 0.002, 17);
+  SimilarityPoseGraph g(n, 2 * n);
+  for (int i = 0; i < n; ++i) g.addNode(Sim3(odo.chained[static_cast<std::size_t>(i)]), i == 0);
+  for (int i = 0; i + 1 < n; ++i)
+    g.addEdge(i, i + 1, odo.relative[static_cast<std::size_t>(i)], similaritySigmas(0.02, 0.002, 0.01));
+  g.addEdge(n - 1, 0, trueSimilarity(truth, odo, n - 1, 0), similaritySigmas(0.01, 0.001, 0.01));
+  alloc::ThreadScope scope;
+  const PoseGraphSummary s = g.optimize();
+  EXPECT_TRUE(s.solved);
   EXPECT_EQ(scope.count(), 0u);
 }
 

@@ -1,7 +1,8 @@
 // The loop correction on its own thread: the map takes the pose graph's solution at a frame boundary; keyframes
 // made during the solve move with their segment, a segment begun during it moves with the one it continues; a
 // segment moved during the solve makes the solution stale; without waiting, the solution is taken once ready; a
-// correction allocates nothing after the first, on either thread.
+// correction allocates nothing after the first, on either thread. In a map whose unit drifts (one camera), the
+// Sim(3) correction takes the drift of the unit out too: keyframes, their points and the segment's odometry unit.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -141,6 +142,81 @@ TEST(LoopCorrection, AfterTheFirstACorrectionAllocatesNothingOnEitherThread) {
   ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_EQ(correction.threadAllocations() - solver_before, 0u);
+}
+
+// One camera around the circle: its unit grows by 1% per keyframe (a metre near keyframe i measures 1.01^i
+// odometry units), and each keyframe holds a point 5 m ahead, in its own unit. The last keyframe sees the first
+// again: the loop measures where, and that its unit is 1.01^39 times the first's.
+struct MonocularLoop {
+  PlaceMap map{64, 1};
+  int32_t segment = -1;
+  std::vector<SE3> truth;
+  std::vector<double> unit;  // odometry units per metre at each keyframe
+  LoopEdge loop;
+};
+
+MonocularLoop monocularLoop(int n) {
+  MonocularLoop d;
+  d.segment = d.map.createSegment(SE3());
+  SE3 chained = poseAt(0, 10);
+  for (int i = 0; i < n; ++i) {
+    d.truth.push_back(poseAt(2 * M_PI * i / n, 10));
+    d.unit.push_back(std::pow(1.01, i));
+    if (i > 0) {
+      SE3 step = d.truth[i - 1].inverse() * d.truth[i];
+      step.t *= d.unit[i - 1];
+      chained = chained * step;
+    }
+    const int slot = d.map.createKeyframe(d.segment, i, static_cast<uint64_t>(i), chained, chained);
+    PlacePoint p;
+    p.p_k = Eigen::Vector3f(0, 0, static_cast<float>(5 * d.unit[i]));
+    p.cam = 0;
+    d.map.addPoint(slot, p);
+    d.map.finishKeyframe(slot);
+  }
+  d.loop = {d.map.keyframe(0).id, d.map.keyframe(n - 1).id, d.truth[0].inverse() * d.truth[n - 1],
+            Vec6::Constant(0.01), 1.0 / d.unit[n - 1],      0.005};
+  return d;
+}
+
+TEST(LoopCorrection, AMonocularLoopTakesTheDriftOfTheUnitOut) {
+  MonocularLoop d = monocularLoop(40);
+  const double error_before = (d.map.keyframe(39).T_w_k.t - d.truth[39].t).norm();
+  LoopCorrection correction(64, 4, /*similarity=*/true);
+  ASSERT_TRUE(correction.similarity());
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  ASSERT_EQ(correction.take(d.map, /*wait=*/true), LoopCorrection::Outcome::Applied);
+  double worst = 0;
+  for (int i = 0; i < 40; ++i) worst = std::max(worst, (d.map.keyframe(i).T_w_k.t - d.truth[i].t).norm());
+  EXPECT_GT(error_before, 3.0);
+  EXPECT_LT(worst, 0.1 * error_before);
+  // Each keyframe's point is back at 5 m, and its unit says how the odometry's relates to the world's.
+  for (int i = 0; i < 40; i += 13) {
+    EXPECT_NEAR(d.map.points(i)[0].p_k.z(), 5.0, 0.25) << "keyframe " << i;
+    EXPECT_NEAR(d.map.keyframe(i).unit * d.unit[i], 1.0, 0.05) << "keyframe " << i;
+  }
+  // The odometry goes on in its own unit: the segment's frame puts its newest pose where the graph put that
+  // keyframe, at the unit the graph found there.
+  EXPECT_NEAR(d.map.segmentScale(d.segment) * d.unit[39], 1.0, 0.05);
+  const SE3 newest = d.map.toWorld(d.segment, d.map.keyframe(39).T_o_k);
+  EXPECT_LT((newest.t - d.map.keyframe(39).T_w_k.t).norm(), 1e-9);
+  EXPECT_LT(rotationAngle(newest.R, d.map.keyframe(39).T_w_k.R), 1e-9);
+}
+
+TEST(LoopCorrection, ARigidCorrectionCannotUndoADriftOfTheUnit) {
+  MonocularLoop similar = monocularLoop(40), rigid = monocularLoop(40);
+  LoopCorrection by_similarity(64, 4, true), by_rigid_motion(64, 4, false);
+  by_similarity.start(similar.map, {&similar.loop, 1}, kOwnRoots);
+  by_rigid_motion.start(rigid.map, {&rigid.loop, 1}, kOwnRoots);
+  ASSERT_EQ(by_similarity.take(similar.map, true), LoopCorrection::Outcome::Applied);
+  ASSERT_EQ(by_rigid_motion.take(rigid.map, true), LoopCorrection::Outcome::Applied);
+  double similar_error = 0, rigid_error = 0;
+  for (int i = 0; i < 40; ++i) {
+    similar_error += (similar.map.keyframe(i).T_w_k.t - similar.truth[i].t).norm();
+    rigid_error += (rigid.map.keyframe(i).T_w_k.t - rigid.truth[i].t).norm();
+  }
+  EXPECT_LT(similar_error, 0.25 * rigid_error);
+  EXPECT_EQ(rigid.map.segmentScale(rigid.segment), 1.0);
 }
 
 }  // namespace

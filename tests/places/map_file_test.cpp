@@ -38,12 +38,14 @@ PlaceMap sampleMap() {
   PlaceMap map(8, 5);
   const int32_t s0 = map.createSegment(SE3());
   const int32_t s1 = map.createSegment(poseAt(3, 0.2), /*placed=*/false);
+  map.setSegmentScale(s1, 0.8);  // a Sim(3) loop corrected its unit
   for (int i = 0; i < 5; ++i) {
     const int k = map.createKeyframe(i % 2 ? s1 : s0, 100 + i, 10 + static_cast<uint64_t>(i), poseAt(i, 0.1 * i),
                                      poseAt(i, 0.1 * i + 0.05));
     for (int j = 0; j < i; ++j) map.addPoint(k, pointAt(10 * i + j, 100 * i + j, static_cast<int16_t>(j % 2)));
     map.finishKeyframe(k);
   }
+  map.scaleKeyframe(3, 1.25);
   map.eraseKeyframe(2);
   return map;
 }
@@ -68,6 +70,8 @@ TEST(MapFile, ThePlaceMapSurvivesAWriteAndARead) {
   EXPECT_TRUE(after.placed(0));
   EXPECT_FALSE(after.placed(1));
   EXPECT_TRUE(after.segmentPose(1).t.isApprox(before.segmentPose(1).t));
+  EXPECT_EQ(after.segmentScale(0), 1.0);
+  EXPECT_EQ(after.segmentScale(1), 0.8);
   EXPECT_EQ(after.keyframe(after.newestKeyframe()).id, before.keyframe(before.newestKeyframe()).id);
   int slot = 0;
   for (int b = 0; b < before.capacity(); ++b) {
@@ -80,6 +84,7 @@ TEST(MapFile, ThePlaceMapSurvivesAWriteAndARead) {
     EXPECT_EQ(r.frame_index, k.frame_index);
     EXPECT_TRUE(r.T_w_k.R.isApprox(k.T_w_k.R) && r.T_w_k.t.isApprox(k.T_w_k.t));
     EXPECT_TRUE(r.T_o_k.t.isApprox(k.T_o_k.t));
+    EXPECT_EQ(r.unit, k.unit);
     // Neighbours are the same keyframes (by id), in other slots.
     EXPECT_EQ(r.previous < 0 ? -1 : after.keyframe(r.previous).id,
               k.previous < 0 ? -1 : before.keyframe(k.previous).id);
@@ -174,7 +179,7 @@ TEST(MapFile, TheEnvelopeRefusesForeignTruncatedCorruptAndNewerFiles) {
   EXPECT_EQ(openError(corrupt), "robot.map: checksum mismatch: the map file is corrupt");
   std::string newer = good;
   newer[8] = 9;
-  EXPECT_EQ(openError(newer), "robot.map: map file version 9, this build reads version 1");
+  EXPECT_EQ(openError(newer), "robot.map: map file version 9, this build reads versions 1 to 2");
 }
 
 Rig isecRig(const std::vector<int>& cameras) {

@@ -82,6 +82,10 @@ struct SE3 {
   SE3(const Mat3& R_, const Vec3& t_) : R(R_), t(t_) {}
   SE3(const Eigen::Quaterniond& q, const Vec3& t_) : R(q.normalized().toRotationMatrix()), t(t_) {}
 
+  static constexpr int kDof = 6;
+  using Tangent = Vec6;
+  using Jacobian = Mat6;
+
   static SE3 identity() { return {}; }
   static SE3 fromMatrix(const Mat4& T) { return {T.topLeftCorner<3, 3>(), T.topRightCorner<3, 1>()}; }
 
@@ -120,6 +124,14 @@ struct SE3 {
     A.topRightCorner<3, 3>() = hat(t) * R;
     A.bottomRightCorner<3, 3>() = R;
     return A;
+  }
+  // ad(xi) zeta = [xi, zeta] of the Lie algebra: [hat(phi) hat(rho); 0 hat(phi)].
+  static Mat6 smallAdjoint(const Vec6& xi) {
+    Mat6 ad = Mat6::Zero();
+    ad.topLeftCorner<3, 3>() = hat(xi.tail<3>());
+    ad.topRightCorner<3, 3>() = hat(xi.head<3>());
+    ad.bottomRightCorner<3, 3>() = hat(xi.tail<3>());
+    return ad;
   }
 };
 

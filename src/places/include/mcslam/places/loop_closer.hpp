@@ -6,13 +6,16 @@
 // as they were when it started (their writer takes its result before it writes them again). A loop is accepted
 // when two consecutive keyframes of the segment find it with the same correction (zero false closures is the
 // rule). It then becomes an edge of the pose graph over every place keyframe, solved on another thread while frames
-// go on (LoopCorrection); at a frame boundary the map takes the solution. Fixed memory.
+// go on (LoopCorrection); at a frame boundary the map takes the solution. In a map whose unit is not metric (one
+// camera) a loop is a similarity: its scale comes from the keyframe's own points against the place's
+// (loopScale), and the graph is over Sim(3). Fixed memory.
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "mcslam/core/background_task.hpp"
 #include "mcslam/places/loop_correction.hpp"
+#include "mcslam/places/loop_scale.hpp"
 #include "mcslam/places/place_map.hpp"
 #include "mcslam/places/places_options.hpp"
 #include "mcslam/places/relocalizer.hpp"
@@ -35,22 +38,28 @@ struct LoopStats {
 
 // The map file's loops part: the loops, then each of the map's segments' root (which segment the loops joined it
 // to). takeLoops() fills `loops` and `roots` (sized by the caller; `roots` at least `segments`) and returns the
-// loop count; InputError from `in` for more loops than `loops` holds or a root that is no union.
+// loop count; InputError from `in` for more loops than `loops` holds or a root that is no union. `with_scales`: the
+// loops have their scales (map files from version 2).
 void putLoops(ByteWriter& out, std::span<const LoopEdge> loops, std::span<const int32_t> roots);
-int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span<int32_t> roots);
-std::size_t loopFileBytes();  // one loop in putLoops' output
+int takeLoops(ByteReader& in, int segments, std::span<LoopEdge> loops, std::span<int32_t> roots,
+              bool with_scales = true);
+std::size_t loopFileBytes(bool with_scales = true);  // one loop in putLoops' output
 
 class LoopCloser {
  public:
-  LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera);
+  // `similarity`: the rig's maps have no metric unit (one camera): loops are closed in Sim(3).
+  LoopCloser(const Rig& rig, const PlacesOptions& options, float scale_factor, int max_features_per_camera,
+             bool similarity = false);
+  bool similarity() const { return correction_.similarity(); }
 
   // The extrinsics the next detection projects with. Not while a detection is in flight.
   void setRig(const Rig& rig) { verifier_.setRig(rig); }
-  // Keyframe `slot` was just added to `map`, with its words to `database` (`features`: the frame it was made of):
-  // starts looking for a loop it closes on the detection thread (copying `features` and `words`). Until
+  // Keyframe `slot` was just added to `map`, with its words to `database` (`features`: the frame it was made of;
+  // `own_points`: for Sim(3) loops, its own point of each keypoint as loopScale() takes them, else empty): starts
+  // looking for a loop it closes on the detection thread (copying `features`, `words` and `own_points`). Until
   // collectDetection() took the result, `map` and `database` must not be written, nor another detection started.
   void startDetection(int slot, const FrameFeatures& features, const FrameWords& words, const PlaceMap& map,
-                      const PlaceDatabase& database);
+                      const PlaceDatabase& database, std::span<const Eigen::Vector3f> own_points = {});
   // Takes the result of the detection in flight, waiting for it with `wait` (otherwise only when it is ready), and
   // decides on it: true when it closed a loop, whose correction is then being solved; the map does not move until
   // takeCorrection(). `map` is the one the detection started on, unchanged.
@@ -73,7 +82,7 @@ class LoopCloser {
   // The map file's part: the loops and which segments they joined. read() replaces them (InputError from `in` for
   // a file that does not fit max_loops or the map's `segments`).
   void write(ByteWriter& out, int segments) const;
-  void read(ByteReader& in, int segments);
+  void read(ByteReader& in, int segments, bool with_scales = true);
   std::size_t maxWrittenBytes() const;
 
  private:
@@ -86,7 +95,7 @@ class LoopCloser {
   void detect();
   // What the detection found for keyframe `slot` decides whether it closes a loop (onto the processing thread).
   bool decide(int slot, const RelocalizationResult& found, const PlaceMap& map);
-  bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
+  bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction, const LoopScale& scale) const;
   bool closesALoop(const PlaceMap& map, int candidate, int slot) const;
   // Starts solving the pose graph of the whole map with the loops so far (LoopCorrection).
   void startCorrection(const PlaceMap& map);
@@ -112,6 +121,7 @@ class LoopCloser {
   int32_t pending_segment_ = -1;
   int64_t pending_candidate_ = -1;
   SE3 pending_correction_;
+  LoopScale pending_scale_;
   LoopStats stats_;
   // The detection in flight: its keyframe, the map and database it reads, copies of the keyframe's frame and words,
   // and what it found.
@@ -120,7 +130,11 @@ class LoopCloser {
   const PlaceDatabase* detect_database_ = nullptr;
   FrameFeatures detect_features_;
   FrameWords detect_words_;
+  int features_per_camera_ = 0;
+  std::vector<Eigen::Vector3f> detect_own_points_;  // Sim(3) loops: the keyframe's own points by keypoint
+  std::vector<double> scale_scratch_;
   RelocalizationResult found_;
+  LoopScale found_scale_;
   Detection detection_;
   BackgroundTask detection_task_;  // last: stops (after the job in flight) before what the job uses goes
 };

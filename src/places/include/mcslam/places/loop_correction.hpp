@@ -4,9 +4,11 @@
 // frame waits for it, and taken into the map at a frame boundary. The keyframes in the graph take its solution;
 // each segment's frame follows its newest keyframe in the graph (the odometry goes on from where the map now puts
 // it), and so do the keyframes made during the solve, which were placed through that frame; a segment begun during
-// the solve (or empty when it began) moves with the one it continues. Fixed memory: the graph and every buffer are
-// sized at construction.
+// the solve (or empty when it began) moves with the one it continues. In a map whose unit is not metric the graph
+// is over similarities: each keyframe also takes a scale, its points grow or shrink with it, and so does the unit of
+// its segment's odometry in the world. Fixed memory: the graph and every buffer are sized at construction.
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -16,16 +18,21 @@
 
 namespace mcslam {
 
-// A loop: keyframe b seen from keyframe a, with the uncertainty of the verification.
+// A loop: keyframe b seen from keyframe a, with the uncertainty of the verification. In a map whose unit is not
+// metric, b's surroundings are `scale` times as large in a's unit as in b's own (a Sim(3) loop); 1 otherwise.
 struct LoopEdge {
   int64_t a = -1, b = -1;  // place keyframe ids
   SE3 T_a_b;
   Vec6 sigma = Vec6::Ones();
+  double scale = 1.0;
+  double sigma_log_scale = 0.0;  // 0: a metric loop, whose scale is exact
 };
 
 class LoopCorrection {
  public:
-  LoopCorrection(int max_keyframes, int max_loops);  // starts the solving thread; its destructor lets a solve finish
+  // Starts the solving thread; its destructor lets a solve finish. `similarity`: the map's unit is not metric (one
+  // camera), so the graph is over Sim(3) poses and its loops measure a scale; SE(3) otherwise.
+  LoopCorrection(int max_keyframes, int max_loops, bool similarity = false);
   LoopCorrection(const LoopCorrection&) = delete;
   LoopCorrection& operator=(const LoopCorrection&) = delete;
 
@@ -34,6 +41,7 @@ class LoopCorrection {
   // running() is false.
   void start(const PlaceMap& map, std::span<const LoopEdge> loops, std::span<const int32_t> root_of_segment);
   bool running() const { return task_.running(); }
+  bool similarity() const { return similar_ != nullptr; }
 
   enum class Outcome {
     None,     // nothing solved to take (none started, or, without `wait`, not finished)
@@ -47,16 +55,26 @@ class LoopCorrection {
 
  private:
   struct GraphSolve final : BackgroundJob {
-    void run() override { graph->optimize(); }
-    backend::PoseGraph* graph = nullptr;
+    void run() override {
+      if (rigid) rigid->optimize();
+      if (similar) similar->optimize();
+    }
+    backend::PoseGraph* rigid = nullptr;
+    backend::SimilarityPoseGraph* similar = nullptr;
   };
 
-  void apply(PlaceMap& map);
+  template <class Graph>
+  void build(Graph& graph, const PlaceMap& map, std::span<const LoopEdge> loops,
+             std::span<const int32_t> root_of_segment);
+  template <class Graph>
+  void apply(const Graph& graph, PlaceMap& map);
   int newestNode(int32_t segment) const;  // the segment's newest keyframe in the graph being solved, or -1
-  void addLoops(std::span<const LoopEdge> loops, int nodes);
+  template <class Graph>
+  void addLoops(Graph& graph, std::span<const LoopEdge> loops, int nodes);
   int nodeOfId(int64_t id, int nodes) const;  // -1 when no node has it (the keyframe was let go)
 
-  backend::PoseGraph graph_;
+  std::unique_ptr<backend::PoseGraph> rigid_;              // a metric map's graph, or
+  std::unique_ptr<backend::SimilarityPoseGraph> similar_;  // the graph of a map whose unit drifts
   GraphSolve solve_;
   std::vector<int32_t> node_of_slot_;
   // What the graph being solved was built from: each node's keyframe id, each segment's newest node and its pose
@@ -65,7 +83,7 @@ class LoopCorrection {
   std::vector<int32_t> nodes_by_id_;  // scratch of start(): the nodes in increasing keyframe id
   std::vector<int32_t> newest_node_;
   std::vector<SE3> newest_pose_before_;
-  std::vector<SE3> segment_delta_;  // scratch of apply(): how each segment's frame moved
+  std::vector<Sim3> segment_delta_;  // scratch of apply(): how each segment's frame moved
   uint64_t graph_reshapes_ = 0;
   int graph_segments_ = 0;
   int64_t graph_next_id_ = 0;

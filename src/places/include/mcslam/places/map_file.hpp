@@ -20,7 +20,11 @@
 namespace mcslam {
 
 struct MapFileHeader {
-  static constexpr uint32_t kVersion = 1;
+  // 2: segments' scales, keyframes' units and loops' scales (Sim(3) loop closure). Version 1 files are read as
+  // metric maps.
+  static constexpr uint32_t kVersion = 2;
+  static constexpr uint32_t kOldestVersion = 1;
+  uint32_t version = kVersion;  // of the file read
   struct Camera {
     uint32_t width = 0, height = 0;
   };
@@ -43,7 +47,8 @@ void beginMapFile(std::string& out, const MapFileHeader& header);
 // Fills in the envelope's payload size and checksum.
 void finishMapFile(std::string& out);
 
-// Checks the envelope of `bytes` (the file `name`: magic, version, size, checksum), reads the header, and leaves
+// Checks the envelope of `bytes` (the file `name`: magic, a version this build reads, size, checksum), reads the
+// header (with the file's version), and leaves
 // `payload` positioned after it. InputError naming the file and the fault.
 MapFileHeader openMapFile(std::string_view bytes, const std::string& name, ByteReader& payload);
 

@@ -3,8 +3,9 @@
 // pose, the odometry pose it was made at and its segment, and its points anchored in its own body frame (position,
 // descriptor, camera, the vocabulary node the descriptor falls in, the odometry's landmark id); points are kept
 // sorted by node, so that matching a frame against a keyframe compares only descriptors of the same node. A
-// segment is a stretch of odometry in one frame `o`; the map knows each segment's T_w_o. Slots are recycled, ids
-// never. Nothing is allocated after construction.
+// segment is a stretch of odometry in one frame `o`; the map knows each segment's T_w_o and, for a map whose unit
+// is not metric (one camera), the scale from its odometry's unit to the world's, which loop closures in Sim(3)
+// change (1 otherwise). Slots are recycled, ids never. Nothing is allocated after construction.
 //
 // One writer: PlaceMemory (and the map file reader). Readers get const views for a call.
 #include <Eigen/Core>
@@ -14,6 +15,7 @@
 
 #include "mcslam/core/binary_io.hpp"
 #include "mcslam/core/se3.hpp"
+#include "mcslam/core/sim3.hpp"
 #include "mcslam/core/time.hpp"
 #include "mcslam/features/keypoint.hpp"
 #include "mcslam/places/places_options.hpp"
@@ -21,7 +23,7 @@
 namespace mcslam {
 
 struct PlacePoint {
-  Eigen::Vector3f p_k = Eigen::Vector3f::Zero();  // in the keyframe's body frame
+  Eigen::Vector3f p_k = Eigen::Vector3f::Zero();  // in the keyframe's body frame, in the world's unit
   int32_t node = 0;                               // vocabulary node of the descriptor (FrameWords::node)
   int16_t cam = -1;                               // camera of the keyframe that observed it
   int8_t octave = 0;
@@ -35,8 +37,12 @@ struct PlaceKeyframe {
   int32_t segment = -1;
   Timestamp t = 0;
   uint64_t frame_index = 0;
-  SE3 T_w_k;                         // world pose (moved by loop closures)
-  SE3 T_o_k;                         // pose in its segment's odometry frame when it was made
+  SE3 T_w_k;  // world pose (moved by loop closures)
+  SE3 T_o_k;  // pose in its segment's odometry frame when it was made
+  // World units per odometry unit at this keyframe: its segment's scale when it was made, times what Sim(3) loop
+  // closures scaled it by since (1 in a metric map). The odometry's motion to the next keyframe, times this, is
+  // that motion in the world's unit.
+  double unit = 1.0;
   int32_t previous = -1, next = -1;  // neighbours in its segment (slots)
   int32_t point_count = 0;
 };
@@ -67,6 +73,8 @@ class PlaceMap {
 
   const PlaceKeyframe& keyframe(int slot) const { return keyframes_[static_cast<std::size_t>(slot)]; }
   void setKeyframePose(int slot, const SE3& T_w_k) { keyframes_[static_cast<std::size_t>(slot)].T_w_k = T_w_k; }
+  // A Sim(3) loop correction scaled the keyframe's surroundings by `s` about its body: its unit and points follow.
+  void scaleKeyframe(int slot, double s);
   // The segment's odometry took a new unit (positions p became center + s (p - center) in its frame): its
   // keyframes' odometry and world poses and their points follow.
   void rescaleSegment(int32_t segment, double s, const Vec3& center);
@@ -92,6 +100,16 @@ class PlaceMap {
   int segments() const { return segment_count_; }
   const SE3& segmentPose(int32_t segment) const { return segment_T_w_o_[static_cast<std::size_t>(segment)]; }
   void setSegmentPose(int32_t segment, const SE3& T_w_o) { segment_T_w_o_[static_cast<std::size_t>(segment)] = T_w_o; }
+  // World units per unit of the segment's odometry (1 until a Sim(3) loop closure corrects the unit).
+  double segmentScale(int32_t segment) const { return segment_scale_[static_cast<std::size_t>(segment)]; }
+  void setSegmentScale(int32_t segment, double s) { segment_scale_[static_cast<std::size_t>(segment)] = s; }
+  // The segment's frame as a similarity: odometry coordinates to world coordinates.
+  Sim3 segmentSimilarity(int32_t segment) const { return Sim3(segmentPose(segment), segmentScale(segment)); }
+  // A pose of the segment's odometry in the world, and back.
+  SE3 toWorld(int32_t segment, const SE3& T_o_b) const;
+  SE3 toOdometry(int32_t segment, const SE3& T_w_b) const;
+  // The segment's T_w_o that puts the odometry's pose T_o_b at T_w_b, keeping its scale.
+  SE3 segmentPoseFor(int32_t segment, const SE3& T_w_b, const SE3& T_o_b) const;
   bool placed(int32_t segment) const { return segment_placed_[static_cast<std::size_t>(segment)] != 0; }
   void setPlaced(int32_t segment) { segment_placed_[static_cast<std::size_t>(segment)] = 1; }
   // The segment, as one rigid piece, now has T_w_o: its keyframes follow (a segment no loop has bent yet).
@@ -104,11 +122,13 @@ class PlaceMap {
   // replaces the map by the file's, its keyframes in slots 0.. in that order; a file that does not fit the capacities,
   // or whose points name a camera beyond `cameras`, is refused (InputError from `in`).
   void write(ByteWriter& out) const;
-  void read(ByteReader& in, int cameras);
+  // `with_scales`: the file has the segments' scales and the keyframes' units (map files before version 2 do not:
+  // their maps are metric).
+  void read(ByteReader& in, int cameras, bool with_scales = true);
   // Bytes write() needs at most for this map's capacities; bytes one keyframe (without its points) and one point
   // take in it.
   std::size_t maxWrittenBytes() const;
-  static std::size_t keyframeFileBytes();
+  static std::size_t keyframeFileBytes(bool with_scales = true);
   static std::size_t pointFileBytes();
   int64_t nextId() const { return next_id_; }
 
@@ -123,6 +143,7 @@ class PlaceMap {
   int64_t next_id_ = 0;
   std::vector<int32_t> newest_of_segment_;
   std::vector<SE3> segment_T_w_o_;
+  std::vector<double> segment_scale_;
   std::vector<uint8_t> segment_placed_;
   std::vector<int32_t> segment_continues_;
   uint64_t reshapes_ = 0;

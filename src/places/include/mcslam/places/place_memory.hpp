@@ -103,6 +103,10 @@ class PlaceMemory {
   LoopCloser loop_closer_;
   std::vector<MapSeed> seeds_;
   std::vector<int64_t> landmark_stamp_;  // per odometry landmark slot: the keyframe id it was last added for
+  // One camera: the last keyframe's own point of each keypoint (cam * max features + kp; NaN: none), for the scale
+  // of a Sim(3) loop. Empty otherwise.
+  std::vector<Eigen::Vector3f> own_points_;
+  int features_per_camera_ = 0;
   int32_t segment_ = -1;
   uint64_t initializations_seen_ = 0;
   uint16_t world_revision_ = 0;

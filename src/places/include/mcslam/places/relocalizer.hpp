@@ -61,6 +61,7 @@ class Relocalizer {
 
   // The extrinsics to project with (the odometry's current rig state).
   void setRig(const Rig& rig);
+  const Rig& rig() const { return rig_; }
 
   // `words` must be of `frame`. `prior` (a slot, or -1) is tried first: the keyframe where tracking was lost, near
   // which a rig that was only blinded still is. `exclude(slot)` true: the keyframe is no candidate.

@@ -1,0 +1,29 @@
+#pragma once
+// The scale of a loop in a map whose unit is not metric: a keyframe recognized an older place, and the verified
+// pose puts the older place's points in the keyframe's body frame, in the older place's unit. The keyframe's own
+// points of the same keypoints are in its own unit: the ratio of their distances from the camera is the ratio of
+// the two units. Robust (the median of the ratios), with the uncertainty of that median from their spread.
+#include <Eigen/Core>
+#include <span>
+
+#include "mcslam/calib/rig.hpp"
+#include "mcslam/places/relocalizer.hpp"
+
+namespace mcslam {
+
+// A monocular odometry's unit drifts like its translation: about 1% from one keyframe to the next.
+inline constexpr double kOdometryLogScaleSigma = 0.01;
+
+struct LoopScale {
+  bool ok = false;             // enough of the inliers have a point of the keyframe's own
+  double scale = 1.0;          // the older place's unit over the keyframe's: its points are `scale` times as far
+  double sigma_log_scale = 0;  // standard deviation of log(scale)
+  int samples = 0;
+};
+
+// `own_points[cam * per_camera + kp]`: the keyframe's own point of that keypoint in its body frame, NaN where it has
+// none. `T_w_b`: the verified pose; `scratch` holds at least inliers.size() values (fixed memory).
+LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::Vector3f> own_points, int per_camera,
+                    const SE3& T_w_b, const Rig& rig, std::span<double> scratch);
+
+}  // namespace mcslam

@@ -1,0 +1,81 @@
+// The scale of a Sim(3) loop: the median ratio of the place's point distances to the keyframe's own, robust to
+// wrong matches, with an uncertainty that shrinks with more points and grows with their spread; too few points
+// give none.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "mcslam/places/loop_scale.hpp"
+
+namespace mcslam {
+namespace {
+
+Rig oneCamera() {
+  Rig rig;
+  RigCamera c;
+  c.T_b_c = SE3(Mat3::Identity(), Vec3(0.1, 0, 0));  // the camera sits off the body's origin
+  rig.cameras.push_back(c);
+  return rig;
+}
+
+struct Scene {
+  std::vector<PlaceMatch> inliers;
+  std::vector<Eigen::Vector3f> own;  // by keypoint
+};
+
+// `n` keypoints, each with the keyframe's own point at some depth and the place's point `scale` times as far from
+// the camera (the place's unit), seen from T_w_b; `wrong` of them are matched to a point elsewhere.
+Scene scene(int n, double scale, int wrong, double noise, const SE3& T_w_b, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> lateral(-2, 2), depth(2, 12);
+  std::normal_distribution<double> jitter(0, noise);
+  const Vec3 centre(0.1, 0, 0);
+  Scene s;
+  s.own.assign(static_cast<std::size_t>(n + 5), Eigen::Vector3f::Constant(std::nanf("")));
+  for (int k = 0; k < n; ++k) {
+    const Vec3 own = centre + Vec3(lateral(rng), lateral(rng), depth(rng));
+    s.own[static_cast<std::size_t>(k)] = own.cast<float>();
+    Vec3 theirs = centre + scale * (own - centre) * std::exp(jitter(rng));
+    if (k < wrong) theirs = centre + 20 * (own - centre);
+    s.inliers.push_back({0, k, T_w_b * theirs, nullptr});
+  }
+  s.inliers.push_back({0, n + 2, T_w_b * Vec3(0, 0, 4), nullptr});  // a keypoint without a point of its own
+  return s;
+}
+
+TEST(LoopScale, TheMedianRatioIsTheScaleDespiteWrongMatches) {
+  const SE3 T_w_b(so3Exp(Vec3(0.1, -0.3, 1.2)), Vec3(4, -2, 1));
+  const Scene s = scene(200, 0.62, 40, 0.02, T_w_b, 1);
+  std::vector<double> scratch(512);
+  const LoopScale r = loopScale(s.inliers, s.own, static_cast<int>(s.own.size()), T_w_b, oneCamera(), scratch);
+  ASSERT_TRUE(r.ok);
+  EXPECT_EQ(r.samples, 200);
+  EXPECT_NEAR(std::log(r.scale), std::log(0.62), 0.01);
+  EXPECT_GT(r.sigma_log_scale, 0.0005);
+  EXPECT_LT(r.sigma_log_scale, 0.01);
+}
+
+TEST(LoopScale, MorePointsAndLessSpreadMakeItSurer) {
+  const SE3 T_w_b;
+  std::vector<double> scratch(2048);
+  const auto sigma = [&](int n, double noise) {
+    const Scene s = scene(n, 1.5, 0, noise, T_w_b, 2);
+    return loopScale(s.inliers, s.own, static_cast<int>(s.own.size()), T_w_b, oneCamera(), scratch).sigma_log_scale;
+  };
+  EXPECT_LT(sigma(800, 0.05), 0.7 * sigma(100, 0.05));
+  EXPECT_LT(sigma(200, 0.01), 0.5 * sigma(200, 0.05));
+}
+
+TEST(LoopScale, TooFewPointsOfItsOwnGiveNoScale) {
+  const SE3 T_w_b;
+  const Scene s = scene(19, 2.0, 0, 0.01, T_w_b, 3);
+  std::vector<double> scratch(64);
+  const LoopScale r = loopScale(s.inliers, s.own, static_cast<int>(s.own.size()), T_w_b, oneCamera(), scratch);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.samples, 19);
+}
+
+}  // namespace
+}  // namespace mcslam
