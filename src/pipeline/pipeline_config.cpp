@@ -124,6 +124,7 @@ void readPlaces(ConfigSection s, PipelineConfig& c) {
   s.read("min_inliers", p.min_inliers, 10, 100000);
   s.read("relocalization_timeout_s", p.relocalization_timeout_s, 0.0, 3600.0);
   s.read("loop_closure", p.loop_closure);
+  s.read("monocular_loop_closure", p.monocular_loop_closure);
   s.read("loop_min_keyframes_apart", p.loop_min_keyframes_apart, 1, 1000000);
   s.read("max_loops", p.max_loops, 1, 1000000);
   s.finish();
@@ -242,6 +243,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    min_inliers: " << c.places.min_inliers << "\n"
      << "    relocalization_timeout_s: " << c.places.relocalization_timeout_s << "\n"
      << "    loop_closure: " << (c.places.loop_closure ? "true" : "false") << "\n"
+     << "    monocular_loop_closure: " << (c.places.monocular_loop_closure ? "true" : "false") << "\n"
      << "    loop_min_keyframes_apart: " << c.places.loop_min_keyframes_apart << "\n"
      << "    max_loops: " << c.places.max_loops << "\n";
   return os.str();

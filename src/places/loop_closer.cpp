@@ -113,12 +113,21 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, const PlaceMap&
   }
   const PlaceKeyframe& k = map.keyframe(slot);
   const SE3 correction = r.T_w_b * k.T_w_k.inverse();  // moves the drifted keyframe onto the recognized place
+  // In Sim(3), what moves the keyframe's surroundings (in its unit) onto the place's.
+  const Sim3 similarity_correction = Sim3(r.T_w_b, found_scale_.scale) * Sim3(k.T_w_k).inverse();
   const int64_t candidate = map.keyframe(r.keyframe).id;
-  const bool confirmed = consistentWithLast(slot, map, correction, found_scale_);
+  const bool confirmed = similarity() ? consistentWithLast(slot, map, similarity_correction, found_scale_)
+                                      : consistentWithLast(slot, map, correction);
+  spdlog::debug(
+      "place memory: keyframe {} verified on keyframe {} ({} inliers): correction {:.3f} m, {:.2f} deg, "
+      "scale {:.4f} +- {:.4f} ({} points){}",
+      k.id, candidate, r.inliers, correction.t.norm(), so3Log(correction.R).norm() * 180 / M_PI, found_scale_.scale,
+      found_scale_.sigma_log_scale, found_scale_.samples, confirmed ? ", confirmed" : "");
   pending_keyframe_ = k.id;
   pending_segment_ = k.segment;
   pending_candidate_ = candidate;
   pending_correction_ = correction;
+  pending_similarity_correction_ = similarity_correction;
   pending_scale_ = found_scale_;
   if (!confirmed) return false;
   // A correction within the loop measurement's own uncertainty (chi-square, 6 dof, 95%; and the scale within two
@@ -135,12 +144,16 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, const PlaceMap&
     spdlog::warn("place memory: {} loop closures kept; no room for another (places.max_loops)", loops_.size());
     return false;
   }
-  loops_[static_cast<std::size_t>(loop_count_++)] = {candidate,
-                                                     k.id,
-                                                     map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b,
-                                                     sigma,
-                                                     similarity() ? found_scale_.scale : 1.0,
-                                                     similarity() ? found_scale_.sigma_log_scale : 0.0};
+  // Kept in the two keyframes' odometry units, which later Sim(3) corrections do not change (their units do).
+  const double unit_a = map.keyframe(r.keyframe).unit, unit_b = k.unit;
+  LoopEdge& loop = loops_[static_cast<std::size_t>(loop_count_++)];
+  loop = {candidate, k.id, map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b, sigma, 1.0, 0.0};
+  if (similarity()) {
+    loop.T_a_b.t /= unit_a;
+    loop.sigma.head<3>() /= unit_a;
+    loop.scale = found_scale_.scale * unit_b / unit_a;
+    loop.sigma_log_scale = found_scale_.sigma_log_scale;
+  }
   const int32_t root_k = findRoot(k.segment);
   const int32_t root_c = findRoot(map.keyframe(r.keyframe).segment);
   if (root_k != root_c) {
@@ -168,6 +181,9 @@ bool LoopCloser::takeCorrection(PlaceMap& map, bool wait) {
   stats_.last_correction_m = accepted_.correction.t.norm();
   stats_.last_correction_deg = so3Log(accepted_.correction.R).norm() * 180.0 / M_PI;
   stats_.last_solve_ms = correction_.lastSolveMs();
+  const backend::PoseGraphSummary& solved = correction_.lastSummary();
+  spdlog::debug("place memory: pose graph of {} keyframes: {} iterations, cost {:.4g} -> {:.4g}", map.size(),
+                solved.iterations, solved.initial_cost, solved.final_cost);
   spdlog::info(
       "place memory: loop closed: keyframe {} (t = {:.3f} s) sees keyframe {} (t = {:.3f} s) again ({} inliers); "
       "correction {:.3f} m, {:.2f} deg; pose graph solved in {:.1f} ms",
@@ -197,20 +213,35 @@ bool LoopCloser::closesALoop(const PlaceMap& map, int candidate, int slot) const
   return path > options_.loop_min_path_ratio * separation + options_.loop_min_path_m;
 }
 
-// The detection of the keyframe before this one (same segment) found a correction that agrees with this one; in
-// Sim(3), also a scale within three standard deviations of the two measurements and the odometry's unit drift
-// from one keyframe to the next.
-bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& correction,
-                                    const LoopScale& scale) const {
+// The detection of the keyframe before this one (same segment) found a correction that agrees with this one.
+bool LoopCloser::followsLast(int slot, const PlaceMap& map) const {
   const PlaceKeyframe& k = map.keyframe(slot);
-  if (pending_keyframe_ < 0 || pending_segment_ != k.segment || k.previous < 0 ||
-      map.keyframe(k.previous).id != pending_keyframe_)
-    return false;
-  if (similarity() && std::abs(std::log(scale.scale / pending_scale_.scale)) >
-                          3 * std::hypot(scale.sigma_log_scale, pending_scale_.sigma_log_scale, kOdometryLogScaleSigma))
-    return false;
+  return pending_keyframe_ >= 0 && pending_segment_ == k.segment && k.previous >= 0 &&
+         map.keyframe(k.previous).id == pending_keyframe_;
+}
+
+bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const {
+  if (!followsLast(slot, map)) return false;
+  const PlaceKeyframe& k = map.keyframe(slot);
   return sameCorrection(pending_correction_, correction,
                         (k.T_w_k.t - map.keyframe(k.previous).T_w_k.t).norm() + correction.t.norm());
+}
+
+// In Sim(3) the two similarities must move this keyframe alike (a rigid correction of a map whose unit is off
+// changes from one keyframe to the next), and their scales agree within three standard deviations of the two
+// measurements and the odometry's unit drift from one keyframe to the next.
+bool LoopCloser::consistentWithLast(int slot, const PlaceMap& map, const Sim3& correction,
+                                    const LoopScale& scale) const {
+  if (!followsLast(slot, map)) return false;
+  if (std::abs(std::log(scale.scale / pending_scale_.scale)) >
+      3 * std::hypot(scale.sigma_log_scale, pending_scale_.sigma_log_scale, kOdometryLogScaleSigma))
+    return false;
+  const PlaceKeyframe& k = map.keyframe(slot);
+  const Sim3 S_w_k(k.T_w_k);
+  const Sim3 moved = correction * S_w_k;
+  const SE3 difference = ((pending_similarity_correction_ * S_w_k).inverse() * moved).rigid();
+  const double step = (k.T_w_k.t - map.keyframe(k.previous).T_w_k.t).norm();
+  return sameCorrection(SE3(), difference, step + (moved.t - k.T_w_k.t).norm());
 }
 
 constexpr std::size_t kLoopBytes = 2 * sizeof(int64_t) + 12 * sizeof(double) + 6 * sizeof(double) + 2 * sizeof(double);

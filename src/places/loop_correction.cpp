@@ -1,6 +1,7 @@
 #include "mcslam/places/loop_correction.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "mcslam/places/loop_scale.hpp"
@@ -40,7 +41,9 @@ struct Edges<SE3> {
     const SE3 T_a_b = ka.T_o_k.inverse() * kb.T_o_k;
     g.addEdge(a, b, T_a_b, odometrySigma(T_a_b));
   }
-  static void loop(backend::PoseGraph& g, int a, int b, const LoopEdge& e) { g.addEdge(a, b, e.T_a_b, e.sigma); }
+  static void loop(backend::PoseGraph& g, int a, int b, const LoopEdge& e, const PlaceKeyframe&, const PlaceKeyframe&) {
+    g.addEdge(a, b, e.T_a_b, e.sigma);
+  }
 };
 
 template <>
@@ -53,8 +56,15 @@ struct Edges<Sim3> {
     T_a_b.t *= ka.unit;
     g.addEdge(a, b, Sim3(T_a_b, ka.unit / kb.unit), withScale(odometrySigma(T_a_b), kOdometryLogScaleSigma));
   }
-  static void loop(backend::SimilarityPoseGraph& g, int a, int b, const LoopEdge& e) {
-    g.addEdge(a, b, Sim3(e.T_a_b, e.scale), withScale(e.sigma, std::max(e.sigma_log_scale, kLoopLogScaleSigmaFloor)));
+  // The loop in the keyframes' current units (those of the graph's nodes).
+  static void loop(backend::SimilarityPoseGraph& g, int a, int b, const LoopEdge& e, const PlaceKeyframe& ka,
+                   const PlaceKeyframe& kb) {
+    SE3 T_a_b = e.T_a_b;
+    T_a_b.t *= ka.unit;
+    Vec6 sigma = e.sigma;
+    sigma.head<3>() *= ka.unit;
+    g.addEdge(a, b, Sim3(T_a_b, e.scale * ka.unit / kb.unit),
+              withScale(sigma, std::max(e.sigma_log_scale, kLoopLogScaleSigmaFloor)));
   }
 };
 
@@ -68,6 +78,7 @@ double scaleOf(const Sim3& S) { return S.s; }
 LoopCorrection::LoopCorrection(int max_keyframes, int max_loops, bool similarity)
     : node_of_slot_(static_cast<std::size_t>(max_keyframes), -1),
       id_of_node_(static_cast<std::size_t>(max_keyframes), -1),
+      slot_of_node_(static_cast<std::size_t>(max_keyframes), -1),
       nodes_by_id_(static_cast<std::size_t>(max_keyframes), -1),
       newest_node_(PlaceMap::kMaxSegments, -1),
       newest_pose_before_(PlaceMap::kMaxSegments),
@@ -91,7 +102,7 @@ int LoopCorrection::nodeOfId(int64_t id, int nodes) const {
 }
 
 template <class Graph>
-void LoopCorrection::addLoops(Graph& graph, std::span<const LoopEdge> loops, int nodes) {
+void LoopCorrection::addLoops(Graph& graph, const PlaceMap& map, std::span<const LoopEdge> loops, int nodes) {
   using Pose = std::decay_t<decltype(graph.pose(0))>;
   const auto end = nodes_by_id_.begin() + nodes;
   std::iota(nodes_by_id_.begin(), end, 0);
@@ -100,7 +111,9 @@ void LoopCorrection::addLoops(Graph& graph, std::span<const LoopEdge> loops, int
   });
   for (const LoopEdge& e : loops) {
     const int a = nodeOfId(e.a, nodes), b = nodeOfId(e.b, nodes);
-    if (a >= 0 && b >= 0) Edges<Pose>::loop(graph, a, b, e);
+    if (a >= 0 && b >= 0)
+      Edges<Pose>::loop(graph, a, b, e, map.keyframe(slot_of_node_[static_cast<std::size_t>(a)]),
+                        map.keyframe(slot_of_node_[static_cast<std::size_t>(b)]));
   }
 }
 
@@ -126,6 +139,7 @@ void LoopCorrection::build(Graph& graph, const PlaceMap& map, std::span<const Lo
     if (!k.alive) continue;
     const int node = graph.addNode(Edges<Pose>::node(k.T_w_k), false);
     node_of_slot_[static_cast<std::size_t>(slot)] = node;
+    slot_of_node_[static_cast<std::size_t>(node)] = slot;
     id_of_node_[static_cast<std::size_t>(node)] = k.id;
     if (k.next < 0) {
       newest_node_[static_cast<std::size_t>(k.segment)] = node;
@@ -139,7 +153,7 @@ void LoopCorrection::build(Graph& graph, const PlaceMap& map, std::span<const Lo
     Edges<Pose>::odometry(graph, node_of_slot_[static_cast<std::size_t>(k.previous)],
                           node_of_slot_[static_cast<std::size_t>(slot)], map.keyframe(k.previous), k);
   }
-  addLoops(graph, loops, graph.nodes());
+  addLoops(graph, map, loops, graph.nodes());
 }
 
 LoopCorrection::Outcome LoopCorrection::take(PlaceMap& map, bool wait) {

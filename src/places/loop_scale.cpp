@@ -24,8 +24,8 @@ LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::
   const SE3 T_b_w = T_w_b.inverse();
   std::size_t n = 0;
   for (const PlaceMatch& m : inliers) {
-    const auto index = static_cast<std::size_t>(m.cam) * static_cast<std::size_t>(per_camera) +
-                       static_cast<std::size_t>(m.kp);
+    const auto index =
+        static_cast<std::size_t>(m.cam) * static_cast<std::size_t>(per_camera) + static_cast<std::size_t>(m.kp);
     if (index >= own_points.size() || n == scratch.size()) continue;
     const Eigen::Vector3f& own = own_points[index];
     if (!own.allFinite()) continue;

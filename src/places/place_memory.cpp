@@ -158,7 +158,8 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   // SE(3) closures need a metric map, Sim(3) ones (one camera) a unit that stays put between loops: a map of a
   // rig without overlap whose unit is still being found waits for it.
   const ScaleStatus scale = odometry.rigState().scale();
-  const bool closable = loop_closer_.similarity() ? scale == ScaleStatus::Monocular : scale == ScaleStatus::Metric;
+  const bool closable = loop_closer_.similarity() ? options_.monocular_loop_closure && scale == ScaleStatus::Monocular
+                                                  : scale == ScaleStatus::Metric;
   if (options_.loop_closure && closable) {
     loop_closer_.setRig(odometry.trackingRig());
     loop_closer_.startDetection(slot, kf.features, words_, map_, database_, own_points_);

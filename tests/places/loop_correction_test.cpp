@@ -219,5 +219,20 @@ TEST(LoopCorrection, ARigidCorrectionCannotUndoADriftOfTheUnit) {
   EXPECT_EQ(rigid.map.segmentScale(rigid.segment), 1.0);
 }
 
+// The loop is kept in the keyframes' odometry units: solving the map again with the same loop, after its first
+// correction changed the keyframes' units, finds the map as it is (it once applied the loop's scale again).
+TEST(LoopCorrection, ASecondSolveDoesNotApplyASimilarityLoopAgain) {
+  MonocularLoop d = monocularLoop(40);
+  LoopCorrection correction(64, 4, /*similarity=*/true);
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
+  const double scale = d.map.segmentScale(d.segment);
+  const SE3 newest = d.map.keyframe(39).T_w_k;
+  correction.start(d.map, {&d.loop, 1}, kOwnRoots);
+  ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
+  EXPECT_NEAR(d.map.segmentScale(d.segment) / scale, 1.0, 0.01);
+  EXPECT_LT((d.map.keyframe(39).T_w_k.t - newest.t).norm(), 0.05);
+}
+
 }  // namespace
 }  // namespace mcslam

@@ -95,7 +95,9 @@ class LoopCloser {
   void detect();
   // What the detection found for keyframe `slot` decides whether it closes a loop (onto the processing thread).
   bool decide(int slot, const RelocalizationResult& found, const PlaceMap& map);
-  bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction, const LoopScale& scale) const;
+  bool followsLast(int slot, const PlaceMap& map) const;
+  bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
+  bool consistentWithLast(int slot, const PlaceMap& map, const Sim3& correction, const LoopScale& scale) const;
   bool closesALoop(const PlaceMap& map, int candidate, int slot) const;
   // Starts solving the pose graph of the whole map with the loops so far (LoopCorrection).
   void startCorrection(const PlaceMap& map);
@@ -121,6 +123,7 @@ class LoopCloser {
   int32_t pending_segment_ = -1;
   int64_t pending_candidate_ = -1;
   SE3 pending_correction_;
+  Sim3 pending_similarity_correction_;
   LoopScale pending_scale_;
   LoopStats stats_;
   // The detection in flight: its keyframe, the map and database it reads, copies of the keyframe's frame and words,

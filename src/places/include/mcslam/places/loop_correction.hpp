@@ -19,7 +19,9 @@
 namespace mcslam {
 
 // A loop: keyframe b seen from keyframe a, with the uncertainty of the verification. In a map whose unit is not
-// metric, b's surroundings are `scale` times as large in a's unit as in b's own (a Sim(3) loop); 1 otherwise.
+// metric (a Sim(3) loop), b's surroundings are `scale` times as large in a's unit as in b's own, and the relative
+// pose is in a's unit, both units the keyframes' odometry's (PlaceKeyframe::unit undone); metric loops are in metres
+// with a scale of 1.
 struct LoopEdge {
   int64_t a = -1, b = -1;  // place keyframe ids
   SE3 T_a_b;
@@ -51,16 +53,15 @@ class LoopCorrection {
   // At a frame boundary. With `wait`, waits for a solve in flight.
   Outcome take(PlaceMap& map, bool wait);
   double lastSolveMs() const { return task_.lastMilliseconds(); }
+  const backend::PoseGraphSummary& lastSummary() const { return solve_.summary; }  // of the solve last taken
   uint64_t threadAllocations() const { return task_.allocations(); }  // by the solving thread; any thread may ask
 
  private:
   struct GraphSolve final : BackgroundJob {
-    void run() override {
-      if (rigid) rigid->optimize();
-      if (similar) similar->optimize();
-    }
+    void run() override { summary = rigid ? rigid->optimize() : similar->optimize(); }
     backend::PoseGraph* rigid = nullptr;
     backend::SimilarityPoseGraph* similar = nullptr;
+    backend::PoseGraphSummary summary;
   };
 
   template <class Graph>
@@ -70,7 +71,7 @@ class LoopCorrection {
   void apply(const Graph& graph, PlaceMap& map);
   int newestNode(int32_t segment) const;  // the segment's newest keyframe in the graph being solved, or -1
   template <class Graph>
-  void addLoops(Graph& graph, std::span<const LoopEdge> loops, int nodes);
+  void addLoops(Graph& graph, const PlaceMap& map, std::span<const LoopEdge> loops, int nodes);
   int nodeOfId(int64_t id, int nodes) const;  // -1 when no node has it (the keyframe was let go)
 
   std::unique_ptr<backend::PoseGraph> rigid_;              // a metric map's graph, or
@@ -80,6 +81,7 @@ class LoopCorrection {
   // What the graph being solved was built from: each node's keyframe id, each segment's newest node and its pose
   // then, the map's reshape count, segment count and next keyframe id.
   std::vector<int64_t> id_of_node_;
+  std::vector<int32_t> slot_of_node_;
   std::vector<int32_t> nodes_by_id_;  // scratch of start(): the nodes in increasing keyframe id
   std::vector<int32_t> newest_node_;
   std::vector<SE3> newest_pose_before_;
