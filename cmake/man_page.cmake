@@ -9,9 +9,9 @@ file(MAKE_DIRECTORY "${work}")
 list(GET PROGRAM -1 program_path)
 
 function(help_of out)
-  execute_process(COMMAND ${PROGRAM} ${ARGN} --help OUTPUT_VARIABLE text ERROR_VARIABLE text RESULT_VARIABLE rc)
+  execute_process(COMMAND ${PROGRAM} ${ARGN} --help OUTPUT_VARIABLE text ERROR_VARIABLE err RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${NAME} ${ARGN} --help failed (${rc}): ${text}")
+    message(FATAL_ERROR "${NAME} ${ARGN} --help failed (${rc}): ${err}")
   endif()
   # CLI11 prints argv[0] in its usage line: the build tree's path, not the name the reader types.
   string(REPLACE "${program_path}" "${NAME}" text "${text}")

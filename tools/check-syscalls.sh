@@ -1,35 +1,37 @@
 #!/usr/bin/env bash
 # Checks that the system-call filter of the systemd unit lets mcslamd do its work, without systemd: runs mcslamd
-# through its modes under strace (a live simulated rig publishing over shared memory and UDP with the realtime:
-# section on, SIGUSR1/SIGHUP/SIGUSR2 and the SIGTERM stop, a second daemon refused the held segment, a PNG replay
-# loading a saved map and ending by itself, a PGM replay, a GigE camera through Aravis when aravis-tools' fake
-# camera is installed, --check-config, a missing GPIO chip), collects every system call made after mcslamd's
-# execve, and checks each against the set the unit's SystemCallFilter= lines allow (their groups expanded with
-# `systemd-analyze syscall-filter`, in order: allow lines add, ~ lines remove). Also checks the /proc files the
-# daemon opens against ProcSubset=pid (only the process directories) when the unit sets it.
-# As root, mcslamd runs as `nobody` with the unit's LimitRTPRIO/LimitMEMLOCK, as the unit runs it (unprivileged).
-# What strace cannot see is a path no scenario takes (USB3 cameras, a GPIO chip that exists): docs/package.md.
+# under strace with every call outside the unit's SystemCallFilter= failed as the filter fails it (strace's
+# -e inject with the unit's SystemCallErrorNumber=; the groups expanded with `systemd-analyze syscall-filter`, in
+# order: allow lines add, ~ lines remove) and, as root, /proc mounted as ProtectProc=/ProcSubset= mount it and the
+# daemon running as `nobody` with the unit's LimitRTPRIO/LimitMEMLOCK when they can be raised. Through its modes: a
+# live simulated rig publishing over shared memory and UDP with the realtime: section on, a periodic map save,
+# SIGUSR1/SIGHUP/SIGUSR2 and the SIGTERM stop, a second daemon refused the held segment, a PNG replay loading the
+# saved map and ending by itself, a PGM replay, --check-config, a GigE camera through Aravis (when aravis-tools' fake
+# camera is installed) and a GPIO chip that does not exist. Lists every call made after mcslamd's execve, the refused
+# ones, and the /proc files outside the process directories that the daemon's libraries tried.
+# What it cannot see is a path no scenario takes (USB3 cameras, a GPIO chip that exists): docs/package.md.
 #
 # Usage: tools/check-syscalls.sh [--bin DIR] [--unit FILE] [--keep DIR]
 #   --bin DIR    the built programs (default build/bin)
 #   --unit FILE  the unit whose filter is checked (default systemd/mcslamd.service)
 #   --keep DIR   keep the traces, logs and the lists of calls there
-# Exit status: 0 every call allowed, 1 a call (or a /proc file) the unit would refuse, or a scenario failed,
-# 2 bad usage, 77 skipped (strace, systemd-analyze or python3 missing, or tracing not permitted here).
+# Exit status: 0 every scenario ended as expected and every refused call is one known to be harmless (listed below
+# with the reason), 1 otherwise, 2 bad usage, 77 skipped (strace, systemd-analyze or python3 missing, or tracing not
+# permitted here).
 set -euo pipefail
-cd "$(dirname "$0")/.."
-
-bin=build/bin
-unit=systemd/mcslamd.service
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+bin="$repo/build/bin"
+unit="$repo/systemd/mcslamd.service"
 keep=""
 while (($#)); do
   case "$1" in
-    --bin) bin="$2"; shift 2 ;;
-    --unit) unit="$2"; shift 2 ;;
-    --keep) keep="$2"; shift 2 ;;
+    --bin) bin="$(realpath -m "$2")"; shift 2 ;;
+    --unit) unit="$(realpath -m "$2")"; shift 2 ;;
+    --keep) keep="$(realpath -m "$2")"; shift 2 ;;
     *) echo "check-syscalls: unknown argument '$1' (see the header of $0)" >&2; exit 2 ;;
   esac
 done
+cd "$repo"
 say() { echo "check-syscalls: $*"; }
 skip() { say "SKIPPED: $*"; exit 77; }
 for tool in strace systemd-analyze python3; do
@@ -40,7 +42,6 @@ for program in mcslamd mcslam-sim mcslam-dataset; do
   [ -x "$bin/$program" ] || { echo "check-syscalls: no $bin/$program (build first)" >&2; exit 2; }
 done
 [ -f "$unit" ] || { echo "check-syscalls: no unit $unit" >&2; exit 2; }
-bin="$(realpath "$bin")"
 
 work="$(mktemp -d /tmp/mcslam-syscalls.XXXXXX)"
 chmod 755 "$work"
