@@ -1,15 +1,16 @@
 # Writes a program's manual page, gzipped as Debian wants it, from its own --help (and each subcommand's) through
 # help2man, with the hand-written sections of docs/man/<name>.h2m (NAME, SEE ALSO; the daemon's signals, exit status,
 # files). Run at build time by mcslam_add_tool (tools/CMakeLists.txt):
-#   cmake -DPROGRAM=<path or emulator;path> -DNAME=<name> -DSECTION=<1|8> -DINCLUDE=<h2m> -DVERSION=<v>
-#         -DHELP2MAN=<path> -DOUTPUT=<name.section.gz> -P man_page.cmake
+#   cmake -DPROGRAM=<path> [-DEMULATOR=<emulator words joined by |>] -DNAME=<name> -DSECTION=<1|8>
+#         -DINCLUDE=<h2m> -DVERSION=<v> -DHELP2MAN=<path> -DOUTPUT=<name.section.gz> -P man_page.cmake
 get_filename_component(work "${OUTPUT}" DIRECTORY)
 set(work "${work}/${NAME}.work")
 file(MAKE_DIRECTORY "${work}")
-list(GET PROGRAM -1 program_path)
+set(program_path "${PROGRAM}")
+string(REPLACE "|" ";" emulator "${EMULATOR}")
 
 function(help_of out)
-  execute_process(COMMAND ${PROGRAM} ${ARGN} --help OUTPUT_VARIABLE text ERROR_VARIABLE err RESULT_VARIABLE rc)
+  execute_process(COMMAND ${emulator} ${PROGRAM} ${ARGN} --help OUTPUT_VARIABLE text ERROR_VARIABLE err RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "${NAME} ${ARGN} --help failed (${rc}): ${err}")
   endif()
