@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Checks the Debian package the way a robot builder meets it, in a clean Debian 12 root (made once with mmdebstrap,
 # kept in ~/.cache/mcslam/; unpacked afresh for every check): install with apt (its dependencies from Debian), the
-# files and the system user in place, mcslamd started as systemd starts it (the unit's ExecStart, as the unit's
-# user, with $STATE_DIRECTORY; systemd itself cannot run in a chroot) with the packaged configuration (a simulated
+# files (manual pages included) and the system user in place, mcslamd started as systemd starts it (the unit's
+# ExecStart, as the unit's user, with $STATE_DIRECTORY; systemd itself cannot run in a chroot, so neither the sandbox
+# nor the system-call filter is applied here: tools/check-syscalls.sh) with the packaged configuration (a simulated
 # rig) becomes ready and publishes poses over shared memory and UDP, a consumer built with find_package(mcslam)
 # against the installed headers reads them, SIGTERM stops it cleanly; an upgrade keeps a changed configuration and
 # the state; remove keeps both, purge removes them. Also the unit's `systemd-analyze security` exposure.
@@ -43,7 +44,8 @@ in_root apt-get install -y -q --no-install-recommends /tmp/mcslam.deb >/dev/null
 for f in /usr/bin/mcslamd /usr/bin/mcslam-run /usr/bin/mcslam-shm-echo /usr/bin/mcslam-udp-echo \
   /usr/lib/*/mcslam/mcslam_image_codec.so /usr/lib/systemd/system/mcslamd.service /etc/mcslamd/mcslamd.yaml \
   /usr/include/mcslam/pose_shm.hpp /usr/lib/*/cmake/mcslam/mcslamConfig.cmake \
-  /usr/share/mcslam/places/orb_vocabulary.mcvoc /usr/share/doc/mcslam/daemon.md; do
+  /usr/share/mcslam/places/orb_vocabulary.mcvoc /usr/share/doc/mcslam/daemon.md /usr/share/man/man8/mcslamd.8.gz \
+  /usr/share/man/man1/mcslam-run.1.gz /usr/share/man/man1/mcslam-shm-echo.1.gz; do
   compgen -G "$root$f" >/dev/null || fail "$f is not installed"
 done
 in_root getent passwd mcslamd >/dev/null || fail "no system user mcslamd"

@@ -21,7 +21,8 @@ TEST(SystemdUnit, HasNotifyWatchdogRestartDedicatedUserAndHardening) {
   ASSERT_FALSE(unit.empty());
   for (const char* line :
        {"Type=notify", "WatchdogSec=", "Restart=on-failure", "DynamicUser=yes", "NoNewPrivileges=yes",
-        "ProtectSystem=strict", "StateDirectory=mcslamd", "LimitRTPRIO=", "ExecStart=/usr/local/bin/mcslamd --config "})
+        "ProtectSystem=strict", "StateDirectory=mcslamd", "LimitRTPRIO=", "ExecStart=/usr/local/bin/mcslamd --config ",
+        "SystemCallFilter=@system-service", "SystemCallErrorNumber=EPERM", "ProtectProc=invisible", "ProcSubset=pid"})
     EXPECT_NE(unit.find(std::string("\n") + line), std::string::npos) << line;
   EXPECT_EQ(unit.find("ReadWritePaths="), std::string::npos) << "the state directory must be the only writable path";
 }
