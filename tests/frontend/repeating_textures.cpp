@@ -90,9 +90,14 @@ std::string writeRepeatingTextures(const std::string& dir, unsigned seed) {
   std::filesystem::create_directories(dir);
   cv::RNG rng(seed);
   const std::pair<const char*, cv::Mat> textures[] = {
-      {"brick_a", brick(rng, 64, 24, 4)}, {"brick_b", brick(rng, 48, 20, 3)}, {"tiles_a", tiles(rng, 64, 3)},
-      {"tiles_b", tiles(rng, 40, 2)},     {"checker", checker(32)},         {"dots", dots(36, 7)},
-      {"grid", grid(44, 4)},              {"motif", motif(56, 48)},
+      {"brick_a", brick(rng, 64, 24, 4)},
+      {"brick_b", brick(rng, 48, 20, 3)},
+      {"tiles_a", tiles(rng, 64, 3)},
+      {"tiles_b", tiles(rng, 40, 2)},
+      {"checker", checker(32)},
+      {"dots", dots(36, 7)},
+      {"grid", grid(44, 4)},
+      {"motif", motif(56, 48)},
   };
   for (const auto& [name, image] : textures) {
     cv::Mat img = image.clone();

