@@ -90,9 +90,12 @@ void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, 
   bool recentred = false;
   if (!makeReference(rig, bearings, images[ref_cam], ref_cam, kr, reference, ref_uv, recentred)) return;
   bool any = false;
-  PartnerCurve curve[64];  // per member (at most one per camera)
+  // Of the member at index 1, the partner of a track that ends with two views: the last one aligned there (a
+  // partner that disagrees is replaced by the last member, aligned next at its index).
+  PartnerCurve curve;
   for (int s = 1; s < size;) {
-    const AlignmentStatus status = alignPartner(rig, images, f, nodes[0], nodes[s], reference, obs[s], curve[s]);
+    const AlignmentStatus status =
+        alignPartner(rig, images, f, nodes[0], nodes[s], reference, obs[s], s == 1 ? &curve : nullptr);
     if (status == AlignmentStatus::Disagrees) {
       ++track_disagreeing_[t];
       swap(s, size - 1);
@@ -111,7 +114,7 @@ void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, 
       obs[0].aligned = true;  // its keypoint moves with it
     }
   }
-  if (size == 2 && options_.unique_two_view && ambiguousPair(images, nodes, obs, reference, curve[1])) {
+  if (size == 2 && options_.unique_two_view && ambiguousPair(images, nodes, obs, reference, curve)) {
     track_ambiguous_[t] = 1;
     size = 0;  // dropped: its keypoints stay mono features
   }
@@ -178,7 +181,7 @@ bool TrackBuilder::makeReference(const Rig& rig, const KeypointBearings& bearing
 // reference patch and the pseudo-inverse of its projection's Jacobian at the unit bearing. Fills `out` when Ok.
 AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* images, const FrameFeatures& f,
                                            int ref_node, int node, const ReferencePatch& ref, Member& out,
-                                           PartnerCurve& curve) const {
+                                           PartnerCurve* curve) const {
   const int r_cam = ref_node / capacity_;
   const int p_cam = node / capacity_, p_index = node % capacity_;
   const ImageView& image = images[p_cam];
@@ -232,9 +235,11 @@ AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* imag
     out.bearing = (m + (rho + a.shift / g_norm) * b).normalized();
     out.sigma_px = a.sigma_px;
     out.aligned = true;
+  }
+  if (a.ok() && curve != nullptr) {
     // The depths the matcher accepts, from infinity (rho = 0) to the nearest, as sample offsets from the match.
     const double rho_match = rho + a.shift / g_norm, spacing = sigma_[kp.octave];
-    EpipolarRepeatSearch& s = curve.search;
+    EpipolarRepeatSearch& s = curve->search;
     s.uv = a.uv;
     s.direction = g / g_norm;
     s.spacing = spacing;
@@ -242,8 +247,8 @@ AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* imag
     s.lowest = static_cast<int>(std::clamp(std::ceil(-rho_match * g_norm / spacing), -bound, bound));
     s.highest = static_cast<int>(
         std::clamp(std::floor((1.0 / options_.triangulation.min_depth - rho_match) * g_norm / spacing), -bound, bound));
-    curve.warp = A;
-    curve.zncc = a.zncc;
+    curve->warp = A;
+    curve->zncc = a.zncc;
   }
   return a.status;
 }

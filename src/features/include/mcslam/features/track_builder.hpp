@@ -83,7 +83,7 @@ class TrackBuilder {
   bool makeReference(const Rig& rig, const KeypointBearings& bearings, const ImageView& image, int cam,
                      const Keypoint& kp, ReferencePatch& ref, Vec2& ref_uv, bool& recentred) const;
   AlignmentStatus alignPartner(const Rig& rig, const ImageView* images, const FrameFeatures& f, int ref_node, int node,
-                               const ReferencePatch& ref, Member& out, PartnerCurve& curve) const;
+                               const ReferencePatch& ref, Member& out, PartnerCurve* curve) const;
   bool ambiguousPair(const ImageView* images, const int32_t* nodes, const Member* obs, const ReferencePatch& ref,
                      const PartnerCurve& curve) const;
   void prefetchPatches(const ImageView* images, const FrameFeatures& f, int track) const;
