@@ -26,8 +26,9 @@ void TrackBuilder::alignTracks(const Rig& rig, const KeypointBearings& bearings,
     if (t + 1 < end) prefetchPatches(images, f, t + 1);  // not beyond the task: another thread may be reordering it
     alignTrack(rig, bearings, images, f, t);
     // Solved here too: the triangulation is most of the emission's work, and the workers share it.
-    track_solution_[t] =
-        solveTrack(rig, f, members_.data() + track_first_[t], aligned_obs_.data() + track_first_[t], track_size_[t]);
+    track_solution_[t] = track_size_[t] < 2 ? TrackSolution{}
+                                            : solveTrack(rig, f, members_.data() + track_first_[t],
+                                                         aligned_obs_.data() + track_first_[t], track_size_[t]);
   }
 }
 
@@ -79,6 +80,7 @@ void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, 
   swap(0, ref);
   track_aligned_[t] = 0;
   track_disagreeing_[t] = 0;
+  track_ambiguous_[t] = 0;
   // The reference side, once for all partners.
   const int ref_cam = nodes[0] / capacity_;
   const Keypoint& kr = keypointOf(0);
@@ -88,8 +90,12 @@ void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, 
   bool recentred = false;
   if (!makeReference(rig, bearings, images[ref_cam], ref_cam, kr, reference, ref_uv, recentred)) return;
   bool any = false;
+  // Of the member at index 1, the partner of a track that ends with two views: the last one aligned there (a
+  // partner that disagrees is replaced by the last member, aligned next at its index).
+  PartnerCurve curve;
   for (int s = 1; s < size;) {
-    const AlignmentStatus status = alignPartner(rig, images, f, nodes[0], nodes[s], reference, obs[s]);
+    const AlignmentStatus status =
+        alignPartner(rig, images, f, nodes[0], nodes[s], reference, obs[s], s == 1 ? &curve : nullptr);
     if (status == AlignmentStatus::Disagrees) {
       ++track_disagreeing_[t];
       swap(s, size - 1);
@@ -108,7 +114,35 @@ void TrackBuilder::alignTrack(const Rig& rig, const KeypointBearings& bearings, 
       obs[0].aligned = true;  // its keypoint moves with it
     }
   }
+  if (size == 2 && options_.unique_two_view && ambiguousPair(images, nodes, obs, reference, curve)) {
+    track_ambiguous_[t] = 1;
+    size = 0;  // dropped: its keypoints stay mono features
+  }
   track_size_[t] = size;
+}
+
+// Whether the partner of a two-view track (member 1, aligned) could as well be a repetition of the true one: a
+// place further along its epipolar curve that looks like it (repeatsAlongEpipolar()) aligns to the reference
+// patch at least as well as the match did. On repeating texture the detector keeps some of many equal corners,
+// and when it missed the true partner the ratio test among keypoints passes a repetition; the true place then
+// correlates better with the reference than the repetition (same surface, same details). Where the match is the
+// true partner, its repetitions correlate less: those tracks stay.
+bool TrackBuilder::ambiguousPair(const ImageView* images, const int32_t* nodes, const Member* obs,
+                                 const ReferencePatch& ref, const PartnerCurve& curve) const {
+  if (!obs[1].aligned) return false;
+  constexpr int kMaxRepeats = 8;  // cost bound: the nearest repetitions on either side
+  int offsets[kMaxRepeats];
+  const ImageView& image = images[nodes[1] / capacity_];
+  const EpipolarRepeatSearch& s = curve.search;
+  const int n =
+      repeatsAlongEpipolar(image, s, options_.alignment.half_size, options_.alignment.min_zncc, offsets, kMaxRepeats);
+  for (int k = 0; k < n; ++k) {
+    const Vec2 start = s.uv + offsets[k] * s.spacing * s.direction;
+    const EpipolarAlignment other =
+        alignAlongEpipolar(ref.patch, image, start, s.direction, curve.warp, s.spacing, options_.alignment);
+    if (other.ok() && other.zncc >= curve.zncc) return true;
+  }
+  return false;
 }
 
 // The reference patch of keypoint kp of camera `cam` at ref_uv (and ref.bearing), recentred on its information
@@ -146,7 +180,8 @@ bool TrackBuilder::makeReference(const Rig& rig, const KeypointBearings& bearing
 // the patch warp is the derivative of the reference pixel -> partner pixel map there. ref: the track's
 // reference patch and the pseudo-inverse of its projection's Jacobian at the unit bearing. Fills `out` when Ok.
 AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* images, const FrameFeatures& f,
-                                           int ref_node, int node, const ReferencePatch& ref, Member& out) const {
+                                           int ref_node, int node, const ReferencePatch& ref, Member& out,
+                                           PartnerCurve* curve) const {
   const int r_cam = ref_node / capacity_;
   const int p_cam = node / capacity_, p_index = node % capacity_;
   const ImageView& image = images[p_cam];
@@ -200,6 +235,20 @@ AlignmentStatus TrackBuilder::alignPartner(const Rig& rig, const ImageView* imag
     out.bearing = (m + (rho + a.shift / g_norm) * b).normalized();
     out.sigma_px = a.sigma_px;
     out.aligned = true;
+  }
+  if (a.ok() && curve != nullptr) {
+    // The depths the matcher accepts, from infinity (rho = 0) to the nearest, as sample offsets from the match.
+    const double rho_match = rho + a.shift / g_norm, spacing = sigma_[kp.octave];
+    EpipolarRepeatSearch& s = curve->search;
+    s.uv = a.uv;
+    s.direction = g / g_norm;
+    s.spacing = spacing;
+    const double bound = EpipolarRepeatSearch::kMaxOffset;
+    s.lowest = static_cast<int>(std::clamp(std::ceil(-rho_match * g_norm / spacing), -bound, bound));
+    s.highest = static_cast<int>(
+        std::clamp(std::floor((1.0 / options_.triangulation.min_depth - rho_match) * g_norm / spacing), -bound, bound));
+    curve->warp = A;
+    curve->zncc = a.zncc;
   }
   return a.status;
 }

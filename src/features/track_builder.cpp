@@ -32,6 +32,7 @@ TrackBuilder::TrackBuilder(const OverlapMap& overlap, const MultiViewOptions& op
   track_size_.resize(parent_.size());
   track_aligned_.resize(parent_.size());
   track_disagreeing_.resize(parent_.size());
+  track_ambiguous_.resize(parent_.size());
   aligned_obs_.resize(parent_.size());
   track_solution_.resize(parent_.size());
 }
@@ -126,6 +127,7 @@ void TrackBuilder::emitTracks(const Rig& rig, FrameFeatures& f) {
       solution = track_solution_[t];  // solved by alignTracks()
       stats_.aligned += track_aligned_[t];
       stats_.disagreeing += track_disagreeing_[t];
+      stats_.ambiguous += track_ambiguous_[t];
     } else {
       for (int s = 0; s < track_size_[t]; ++s) {
         const Keypoint& kp = f.sets[nodes[s] / capacity_].keypoints[nodes[s] % capacity_];

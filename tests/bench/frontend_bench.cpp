@@ -14,6 +14,9 @@
 //                                   multi-view partners on (multiview: align_subpixel; counters aligned,
 //                                   disagreeing: partners per frame)
 //   FrontEnd5CamAligned/off         anchor: the same front-end and input with the alignment off
+//   FrontEnd5CamUnique/mcslam       the default front-end again (counter ambiguous: two-view tracks dropped per
+//                                   frame because the partner's patch recurs along the epipolar curve)
+//   FrontEnd5CamUnique/off          anchor: the same with that check off (multiview: unique_two_view)
 // Every case also reports process_cpu_ms: the CPU of all threads per rig frame (the CPU column is the main thread's
 // alone, and work moved onto the workers leaves it).
 #include <benchmark/benchmark.h>
@@ -71,10 +74,11 @@ const std::vector<Subset>& subsets() {
   return s;
 }
 
-PipelineConfig configFor(const Rig& rig, bool align_subpixel = false) {
+PipelineConfig configFor(const Rig& rig, bool align_subpixel = false, bool unique_two_view = true) {
   PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
   config.feature_threads = kThreads;
   config.multiview.align_subpixel = align_subpixel;
+  config.multiview.unique_two_view = unique_two_view;
   return config;
 }
 
@@ -87,7 +91,7 @@ double processCpuMs() {
 // Per-frame counters, averaged over the iterations.
 struct Totals {
   double keypoints = 0, multiview = 0, mono = 0, extraction_ms = 0, multiview_ms = 0, process_cpu_ms = 0;
-  double aligned = 0, disagreeing = 0;
+  double aligned = 0, disagreeing = 0, ambiguous = 0;
   int frames = 0;
   void add(const FrameFeatures& f, double ext_ms, double mv_ms) {
     keypoints += f.keypointCount();
@@ -108,14 +112,16 @@ struct Totals {
     if (aligned + disagreeing > 0) {
       state.counters["aligned"] = aligned / n;
       state.counters["disagreeing"] = disagreeing / n;
+      state.counters["ambiguous"] = ambiguous / n;
     }
   }
 };
 
-void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras, bool align_subpixel = false) {
+void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras, bool align_subpixel = false,
+                 bool unique_two_view = true) {
   const RenderedSequence& seq = sequence();
   const Rig rig = seq.sim->rig().subset(cameras);
-  FrontEnd front_end(rig, configFor(rig, align_subpixel));
+  FrontEnd front_end(rig, configFor(rig, align_subpixel, unique_two_view));
   FrameFeatures f(rig.size(), front_end.capacityPerCamera());
   std::vector<ImageView> views(rig.size());
   std::unique_ptr<bool[]> present(new bool[rig.size()]);
@@ -133,6 +139,7 @@ void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras, bool 
     totals.process_cpu_ms += processCpuMs() - cpu0;
     totals.aligned += front_end.multiViewStats().aligned;
     totals.disagreeing += front_end.multiViewStats().disagreeing;
+    totals.ambiguous += front_end.multiViewStats().ambiguous;
     totals.add(f, front_end.timing().extraction_ms, front_end.timing().multiview_ms);
     k = (k + 1) % kFrames;
   }
@@ -142,6 +149,7 @@ void runFrontEnd(benchmark::State& state, const std::vector<int>& cameras, bool 
 void FrontEnd5CamMcslam(benchmark::State& state) { runFrontEnd(state, {0, 1, 2, 3, 4}); }
 void FrontEnd5CamAlignedMcslam(benchmark::State& state) { runFrontEnd(state, {0, 1, 2, 3, 4}, true); }
 void FrontEnd5CamAlignedOff(benchmark::State& state) { runFrontEnd(state, {0, 1, 2, 3, 4}, false); }
+void FrontEnd5CamUniqueOff(benchmark::State& state) { runFrontEnd(state, {0, 1, 2, 3, 4}, true, false); }
 
 // cv::ORB with the same feature count and pyramid, one camera per OpenCV task on 2 threads, then our matcher.
 void FrontEnd5CamCvOrb(benchmark::State& state) {
@@ -240,6 +248,16 @@ BENCHMARK(FrontEnd5CamAlignedMcslam)
     ->Iterations(3 * kFrames);
 BENCHMARK(FrontEnd5CamAlignedOff)
     ->Name("FrontEnd5CamAligned/off")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3 * kFrames);
+BENCHMARK(FrontEnd5CamAlignedMcslam)
+    ->Name("FrontEnd5CamUnique/mcslam")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3 * kFrames);
+BENCHMARK(FrontEnd5CamUniqueOff)
+    ->Name("FrontEnd5CamUnique/off")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3 * kFrames);

@@ -29,4 +29,8 @@ RenderedFrame renderFrame(sim::Simulation& sim, int frame, const std::vector<int
 // Depth along camera's optical axis at the pixel nearest (x, y); 0 outside or where nothing was hit.
 double depthAt(const sim::DepthImage& depth, double x, double y);
 
+// Truth at a keypoint (x, y, octave) for a depth estimate: the depth at its pixel, or on a depth discontinuity
+// the depth within the keypoint's rounding nearest to the estimate (*edge tells which; sim_frames.cpp says why).
+double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, double estimate, bool* edge = nullptr);
+
 }  // namespace mcslam::test

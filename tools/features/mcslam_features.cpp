@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include "mcslam/calib/calibration_io.hpp"
+#include "mcslam/core/config_section.hpp"
 #include "mcslam/core/error.hpp"
 #include "mcslam/core/json_writer.hpp"
 #include "mcslam/dataset/dataset.hpp"
@@ -62,12 +64,13 @@ void printJson(const FrameFeatures& f, std::size_t frame) {
 
 int main(int argc, char** argv) {
   CLI::App app{"mcslam-features: multi-view and mono features of one rig frame"};
-  std::string dataset_dir, cameras_text;
+  std::string dataset_dir, cameras_text, config_path;
   std::size_t frame = 0;
   bool json = false;
   app.add_option("DATASET", dataset_dir, "Dataset folder (ASL with camchain.yaml, EuRoC or KITTI)")->required();
   app.add_option("--frame", frame, "Rig frame index (0-based)")->capture_default_str();
   app.add_option("--cameras", cameras_text, "Cameras to use, by calibration index, e.g. 0,1,2");
+  app.add_option("--config", config_path, "YAML with a slam: section (as mcslam-run --config); default: built-in");
   app.add_flag("--json", json, "Print JSON: multiview[keypoints[camera,x,y,octave], has_point, point_body], mono[...]");
   CLI11_PARSE(app, argc, argv);
   try {
@@ -78,7 +81,12 @@ int main(int argc, char** argv) {
       throw InputError(dataset_dir + ": --frame " + std::to_string(frame) + " is past the last frame (" +
                        std::to_string(ds.size()) + " frames)");
     }
-    const PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", ds.rig());
+    YAML::Node slam;
+    if (!config_path.empty()) {
+      const YAML::Node root = parseYamlText(readTextFile(config_path, kMaxConfigFileBytes), config_path);
+      slam = root.IsMap() && root["slam"] ? root["slam"] : root;
+    }
+    const PipelineConfig config = parsePipelineConfig(slam, config_path.empty() ? "defaults" : config_path, ds.rig());
     FrontEnd front(ds.rig(), config);
     DatasetFrame images;
     images.load(ds, frame);
@@ -102,6 +110,7 @@ int main(int argc, char** argv) {
       }
       std::printf("points by relative depth sigma: <=1%% %d, <=3%% %d, <=6%% %d, <=15%% %d\n", within[0], within[1],
                   within[2], within[3]);
+      std::printf("two-view tracks dropped as ambiguous along the epipolar curve: %d\n", s.ambiguous);
       std::printf("front-end: extraction %.1f ms, multi-view %.1f ms\n", front.timing().extraction_ms,
                   front.timing().multiview_ms);
     }

@@ -34,6 +34,12 @@ struct MultiViewOptions {
   // With the alignment: the reference pixel moves to where its patch's information lies (informationCentroid()),
   // before the partners are aligned to it, so that the point is placed where its depth was measured.
   bool recentre_reference = true;
+  // With the alignment: a track left with two views is dropped when, further along the partner's epipolar curve
+  // (depths the matcher accepts), a place that looks like the partner aligns to the reference at least as well
+  // as the partner did: the partner may be a repetition of an undetected true one, and no third ray checks its
+  // depth (TrackBuilder::ambiguousPair()). Tracks of three or more views are not checked (BENCHMARKS.md
+  // section 3, "Repeating texture").
+  bool unique_two_view = true;
   EpipolarAlignmentOptions alignment;
 
   MultiViewOptions() { triangulation.max_relative_depth_sigma = 0.01; }
@@ -47,6 +53,7 @@ struct MultiViewStats {
   int dropped = 0;        // tracks rejected by geometry
   int aligned = 0;        // partner keypoints aligned to their reference to subpixel precision
   int disagreeing = 0;    // partner keypoints whose patch did not match the reference's: removed from the track
+  int ambiguous = 0;      // two-view tracks dropped: another place on the partner's curve fits the reference as well
 };
 
 // A mutual best match between keypoint kp_a of camera cam_a and keypoint kp_b of camera cam_b.

@@ -15,6 +15,7 @@
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/core/image.hpp"
 #include "mcslam/features/epipolar_alignment.hpp"
+#include "mcslam/features/epipolar_uniqueness.hpp"
 #include "mcslam/features/frame_features.hpp"
 #include "mcslam/features/keypoint_bearings.hpp"
 #include "mcslam/features/multiview_types.hpp"
@@ -58,6 +59,12 @@ class TrackBuilder {
     int16_t medoid = 0;  // the member whose descriptor represents the track
     bool keep = false, has_point = false, metric = false;
   };
+  // Where an aligned partner lies on its epipolar curve, for the uniqueness test (ambiguousPair()).
+  struct PartnerCurve {
+    EpipolarRepeatSearch search;
+    Mat2 warp = Mat2::Identity();  // reference pixel offset -> partner pixel offset
+    double zncc = 0;               // of the aligned match with the reference
+  };
   struct ReferencePatch {
     AlignmentTemplate patch;
     Eigen::Matrix<double, 3, 2> J_pinv;  // reference pixel offset -> bearing offset normal to the ray
@@ -76,7 +83,9 @@ class TrackBuilder {
   bool makeReference(const Rig& rig, const KeypointBearings& bearings, const ImageView& image, int cam,
                      const Keypoint& kp, ReferencePatch& ref, Vec2& ref_uv, bool& recentred) const;
   AlignmentStatus alignPartner(const Rig& rig, const ImageView* images, const FrameFeatures& f, int ref_node, int node,
-                               const ReferencePatch& ref, Member& out) const;
+                               const ReferencePatch& ref, Member& out, PartnerCurve* curve) const;
+  bool ambiguousPair(const ImageView* images, const int32_t* nodes, const Member* obs, const ReferencePatch& ref,
+                     const PartnerCurve& curve) const;
   void prefetchPatches(const ImageView* images, const FrameFeatures& f, int track) const;
 
   const OverlapMap& overlap_;
@@ -102,6 +111,7 @@ class TrackBuilder {
   std::vector<int32_t> track_size_;
   std::vector<int16_t> track_aligned_;
   std::vector<int16_t> track_disagreeing_;
+  std::vector<uint8_t> track_ambiguous_;
   std::vector<Member> aligned_obs_;
   std::vector<TrackSolution> track_solution_;  // per track, when aligned: solved on the alignment's threads
   bool aligned_frame_ = false;                 // this frame's tracks are aligned
