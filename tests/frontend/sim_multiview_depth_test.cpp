@@ -123,11 +123,11 @@ DepthStats indoorStats() {
 
 // What the front-end achieves with partners aligned to their reference keypoint along the epipolar curve
 // (MultiViewOptions::align_subpixel, the default), the reference moved to where its patch's information lies
-// (recentre_reference), and two-view tracks whose partner repeats along the epipolar curve dropped
-// (unique_two_view), regression guard: measured 3294 points, 0.948 within 2%, 0.011 gross, 0.924 within 3
-// sigmas; 2274 metric, 2232 of them within 2%; 2601 judged at 2% (sigma <= 2%/3), 2566 within 2% (0.9865); judged
-// misses 11 more than 10% off, 7 at a discontinuity of the truth, 1 two-view, 16 else. Without unique_two_view:
-// 3453 points, 0.946 within 2%, 0.012 gross; 2646 judged, 2609 within 2% (0.986). Without the recentring:
+// (recentre_reference), regression guard: measured 3453 points, 0.946 within 2%, 0.012 gross; 2646 judged at 2%
+// (sigma <= 2%/3), 2609 within 2% (0.986). With two-view tracks whose partner repeats along the epipolar curve
+// dropped (unique_two_view, off by default): 3294 points, 0.948 within 2%, 0.011 gross, 0.924 within 3 sigmas;
+// 2274 metric, 2232 of them within 2%; 2601 judged, 2566 within 2% (0.9865); judged misses 11 more than 10% off, 7
+// at a discontinuity of the truth, 1 two-view, 16 else. Without the recentring:
 // 3486 points, 0.935 within 2%, 0.015 gross; 2658 judged, 2596 within 2% (0.977), misses 24 / 9 / 4 / 25: most
 // gross misses were corners 2-5 pixels beside a silhouette against a flat background, whose patch aligned the
 // silhouette's edge (the foreground's depth) while their pixel shows the background. Without the alignment,

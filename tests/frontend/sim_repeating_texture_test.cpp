@@ -75,7 +75,8 @@ WorldFigures measure(const std::string& world, unsigned seed) {
   cfg.textures_dir = test::writeRepeatingTextures(testing::TempDir() + "mcslam_repeating_textures");
   sim::Simulation sim(cfg);
   const Rig rig = sim.rig().subset({0, 1, 2, 3, 4});
-  const PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
+  PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);
+  config.multiview.unique_two_view = true;  // off by default (BENCHMARKS.md section 3, "Repeating texture")
   WorldFigures w;
   const int n = sim.frameCount();
   for (const int frame : {n / 8, 3 * n / 8, 5 * n / 8, 7 * n / 8}) {
