@@ -12,7 +12,7 @@ ci=0
 case "${1:-}" in
   "") ;;
   --ci) ci=1 ;;
-  -h|--help) sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   *) echo "run-tests: unknown option '$1' (see --help)" >&2; exit 2 ;;
 esac
 
