@@ -37,9 +37,9 @@ struct MultiViewOptions {
   // With the alignment: a track left with two views is dropped when, further along the partner's epipolar curve
   // (depths the matcher accepts), a place that looks like the partner aligns to the reference at least as well
   // as the partner did: the partner may be a repetition of an undetected true one, and no third ray checks its
-  // depth (TrackBuilder::ambiguousPair()). Tracks of three or more views are not checked (BENCHMARKS.md
-  // section 3, "Repeating texture"). Off by default: it halves the wrong depths on repeating texture, but on the
-  // real EuRoC excerpt the ATE was worse in 8 of 9 runs (3.75 against 3.62 mm) and it costs CPU on every frame.
+  // depth (TrackBuilder::ambiguousPair()). Tracks of three or more views are not checked. Off by default: what it
+  // removes on repeating texture it has not yet repaid in accuracy on real frames, and it costs CPU on every
+  // frame (BENCHMARKS.md section 3, "Repeating texture").
   bool unique_two_view = false;
   EpipolarAlignmentOptions alignment;
 
