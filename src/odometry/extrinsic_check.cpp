@@ -1,5 +1,5 @@
 #include "extrinsic_check.hpp"
-#include "median.hpp"
+#include "mcslam/core/median.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "median.hpp"
+#include "mcslam/core/median.hpp"
 
 namespace mcslam {
 

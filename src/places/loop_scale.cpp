@@ -1,7 +1,8 @@
 #include "mcslam/places/loop_scale.hpp"
 
-#include <algorithm>
 #include <cmath>
+
+#include "mcslam/core/median.hpp"
 
 namespace mcslam {
 
@@ -10,16 +11,10 @@ namespace {
 // Fewer depths than this give no median worth a loop: a loop holds the whole map's unit.
 constexpr int kMinSamples = 20;
 
-double median(std::span<double> values) {
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
-
 }  // namespace
 
 LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::Vector3f> own_points, int per_camera,
-                    const SE3& T_w_b, const Rig& rig, std::span<double> scratch) {
+                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch) {
   LoopScale result;
   const SE3 T_b_w = T_w_b.inverse();
   std::size_t n = 0;
@@ -37,10 +32,9 @@ LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::
   }
   result.samples = static_cast<int>(n);
   if (result.samples < kMinSamples) return result;
-  const std::span<double> logs = scratch.first(n);
-  const double log_scale = median(logs);
-  for (double& v : logs) v = std::abs(v - log_scale);
-  const double mad = median(logs);
+  const double log_scale = medianOf(scratch, result.samples);
+  for (std::size_t i = 0; i < n; ++i) scratch[i] = std::abs(scratch[i] - log_scale);
+  const double mad = medianOf(scratch, result.samples);
   result.ok = true;
   result.scale = std::exp(log_scale);
   // The median's standard error: 1.4826 MAD is the spread of one ratio, and the median of n has about 1.25 times

@@ -5,6 +5,7 @@
 // the two units. Robust (the median of the ratios), with the uncertainty of that median from their spread.
 #include <Eigen/Core>
 #include <span>
+#include <vector>
 
 #include "mcslam/calib/rig.hpp"
 #include "mcslam/places/relocalizer.hpp"
@@ -22,8 +23,9 @@ struct LoopScale {
 };
 
 // `own_points[cam * per_camera + kp]`: the keyframe's own point of that keypoint in its body frame, NaN where it has
-// none. `T_w_b`: the verified pose; `scratch` holds at least inliers.size() values (fixed memory).
+// none. `T_w_b`: the verified pose; `scratch` is sized by the caller (fixed memory): at most its size of the
+// inliers are used.
 LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::Vector3f> own_points, int per_camera,
-                    const SE3& T_w_b, const Rig& rig, std::span<double> scratch);
+                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch);
 
 }  // namespace mcslam
