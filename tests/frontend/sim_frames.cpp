@@ -5,6 +5,8 @@
 #include <memory>
 #include <utility>
 
+#include "mcslam/pipeline/front_end.hpp"
+
 namespace mcslam::test {
 
 sim::Simulation& sharedSimulation(const std::string& rig, const std::string& world) {
@@ -84,6 +86,29 @@ double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, d
   }
   if (edge != nullptr) *edge = discontinuity;
   return discontinuity ? nearest : centre;
+}
+
+void forEachFrontCameraDepth(sim::Simulation& sim, const PipelineConfig& config, int frame, double max_sigma,
+                             const std::function<void(const MultiViewFeature& mv, double error, bool edge)>& visit) {
+  const std::vector<int> front = {0, 1, 2, 3, 4};
+  const Rig rig = sim.rig().subset(front);  // keeps the body frame: camera c here is camera c of the preset
+  FrontEnd front_end(rig, config);
+  const RenderedFrame rendered = renderFrame(sim, frame, front);
+  RigFrameView view = rendered.view();
+  view.cameras = rig.size();
+  FrameFeatures f(rig.size(), front_end.capacityPerCamera());
+  front_end.compute(view, f);
+  for (int t = 0; t < f.mv_count; ++t) {
+    const MultiViewFeature& mv = f.mv[t];
+    if (!mv.has_point || mv.relative_depth_sigma > max_sigma) continue;
+    const KeypointRef& ref = f.mv_refs[mv.first];
+    const Keypoint& kp = f.sets[ref.cam].keypoints[ref.index];
+    const double z = (rig.T_b_c(ref.cam).inverse() * mv.p_b).z();
+    bool edge = false;
+    const double truth = trueDepth(rendered.depths[ref.cam], kp.x, kp.y, kp.octave, z, &edge);
+    if (!(truth > 0)) continue;  // nothing rendered there
+    visit(mv, std::abs(z - truth) / truth, edge);
+  }
 }
 
 }  // namespace mcslam::test

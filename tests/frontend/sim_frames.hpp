@@ -1,11 +1,13 @@
 #pragma once
 // Rendered rig frames for front-end tests: one Simulation per (rig, world) per process, built on first
 // use (world construction takes seconds), and frames rendered with their depth along the optical axis.
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "mcslam/core/image.hpp"
 #include "mcslam/pipeline/frame_processor.hpp"
+#include "mcslam/pipeline/pipeline_config.hpp"
 #include "mcslam/sim/simulation.hpp"
 
 namespace mcslam::test {
@@ -32,5 +34,11 @@ double depthAt(const sim::DepthImage& depth, double x, double y);
 // Truth at a keypoint (x, y, octave) for a depth estimate: the depth at its pixel, or on a depth discontinuity
 // the depth within the keypoint's rounding nearest to the estimate (*edge tells which; sim_frames.cpp says why).
 double trueDepth(const sim::DepthImage& depth, double x, double y, int octave, double estimate, bool* edge = nullptr);
+
+// The front-end of `config` on the front cameras 0-4 of frame `frame`: each multi-view feature with a point whose
+// relative depth sigma is at most `max_sigma`, where something was rendered, with the relative error of its depth
+// (along its reference camera's axis) against the rendered one, and whether that truth lies on a discontinuity.
+void forEachFrontCameraDepth(sim::Simulation& sim, const PipelineConfig& config, int frame, double max_sigma,
+                             const std::function<void(const MultiViewFeature& mv, double error, bool edge)>& visit);
 
 }  // namespace mcslam::test

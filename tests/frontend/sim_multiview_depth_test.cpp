@@ -40,50 +40,37 @@ constexpr double kWellKnownDepthSigma = 0.06;
 // point of an honest population would have to be exactly Gaussian to reach 98%).
 constexpr double kJudgedAtTwoPercentSigma = 0.02 / 3;
 
-DepthStats checkFrame(sim::Simulation& sim, int frame) {
-  const std::vector<int> front = {0, 1, 2, 3, 4};
-  const Rig rig = sim.rig().subset(front);  // keeps the body frame: camera c here is camera c of the preset
-  const PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);  // the product's: aligned
-  FrontEnd front_end(rig, config);
-  const test::RenderedFrame rendered = test::renderFrame(sim, frame, front);
-  RigFrameView view = rendered.view();
-  view.cameras = rig.size();
-  FrameFeatures f(rig.size(), front_end.capacityPerCamera());
-  front_end.compute(view, f);
-
-  DepthStats s;
-  for (int t = 0; t < f.mv_count; ++t) {
-    const MultiViewFeature& mv = f.mv[t];
-    if (!mv.has_point || mv.relative_depth_sigma > kWellKnownDepthSigma) continue;  // (the judged are among them)
-    const KeypointRef& ref = f.mv_refs[mv.first];
-    const Keypoint& kp = f.sets[ref.cam].keypoints[ref.index];
-    const double z = (rig.T_b_c(ref.cam).inverse() * mv.p_b).z();
-    bool edge = false;
-    const double truth = test::trueDepth(rendered.depths[ref.cam], kp.x, kp.y, kp.octave, z, &edge);
-    if (!(truth > 0)) continue;  // nothing rendered there
-    const double error = std::abs(z - truth) / truth;
-    ++s.points;
-    s.within += error < 0.02 ? 1 : 0;
-    s.gross += error > 0.10 ? 1 : 0;
-    s.honest += error < 3.0 * mv.relative_depth_sigma ? 1 : 0;
-    s.metric += mv.metric ? 1 : 0;
-    s.metric_within += mv.metric && error < 0.02 ? 1 : 0;
-    if (mv.relative_depth_sigma <= kJudgedAtTwoPercentSigma) {
-      ++s.judged;
-      s.judged_within += error < 0.02 ? 1 : 0;
-      if (!(error < 0.02)) {
-        if (error > 0.10) {
-          ++s.miss_gross;
-        } else if (edge) {
-          ++s.miss_edge;
-        } else if (mv.size == 2) {
-          ++s.miss_two_view;
-        } else {
-          ++s.miss_other;
-        }
-      }
-    }
+// Each point of one frame counted, against the rendered depth; the judged ones' misses by their likely cause.
+void count(const MultiViewFeature& mv, double error, bool edge, DepthStats& s) {
+  ++s.points;
+  s.within += error < 0.02 ? 1 : 0;
+  s.gross += error > 0.10 ? 1 : 0;
+  s.honest += error < 3.0 * mv.relative_depth_sigma ? 1 : 0;
+  s.metric += mv.metric ? 1 : 0;
+  s.metric_within += mv.metric && error < 0.02 ? 1 : 0;
+  if (mv.relative_depth_sigma > kJudgedAtTwoPercentSigma) return;
+  ++s.judged;
+  s.judged_within += error < 0.02 ? 1 : 0;
+  if (error < 0.02) return;
+  if (error > 0.10) {
+    ++s.miss_gross;
+  } else if (edge) {
+    ++s.miss_edge;
+  } else if (mv.size == 2) {
+    ++s.miss_two_view;
+  } else {
+    ++s.miss_other;
   }
+}
+
+DepthStats checkFrame(sim::Simulation& sim, int frame) {
+  const Rig rig = sim.rig().subset({0, 1, 2, 3, 4});
+  const PipelineConfig config = parsePipelineConfig(YAML::Node(), "defaults", rig);  // the product's: aligned
+  DepthStats s;
+  // (The judged points are among those of a well-known depth.)
+  test::forEachFrontCameraDepth(
+      sim, config, frame, kWellKnownDepthSigma,
+      [&](const MultiViewFeature& mv, double error, bool edge) { count(mv, error, edge, s); });
   return s;
 }
 

@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <string>
 
-#include "mcslam/pipeline/front_end.hpp"
 #include "mcslam/pipeline/pipeline_config.hpp"
 #include "repeating_textures.hpp"
 #include "sim_frames.hpp"
@@ -40,30 +39,15 @@ struct WorldFigures {
 };
 
 Counts countFrame(sim::Simulation& sim, const PipelineConfig& config, int frame) {
-  const std::vector<int> front = {0, 1, 2, 3, 4};
-  const Rig rig = sim.rig().subset(front);
-  FrontEnd front_end(rig, config);
-  const test::RenderedFrame rendered = test::renderFrame(sim, frame, front);
-  RigFrameView view = rendered.view();
-  view.cameras = rig.size();
-  FrameFeatures f(rig.size(), front_end.capacityPerCamera());
-  front_end.compute(view, f);
   Counts c;
-  for (int t = 0; t < f.mv_count; ++t) {
-    const MultiViewFeature& mv = f.mv[t];
-    if (!mv.has_point || mv.relative_depth_sigma > kWellKnownDepthSigma) continue;
-    const KeypointRef& ref = f.mv_refs[mv.first];
-    const Keypoint& kp = f.sets[ref.cam].keypoints[ref.index];
-    const double z = (rig.T_b_c(ref.cam).inverse() * mv.p_b).z();
-    const double truth = test::trueDepth(rendered.depths[ref.cam], kp.x, kp.y, kp.octave, z);
-    if (!(truth > 0)) continue;
-    const double error = std::abs(z - truth) / truth;
-    ++c.points;
-    c.within += error < 0.02 ? 1 : 0;
-    c.off += error > 0.05 ? 1 : 0;
-    c.two_view += mv.size == 2 ? 1 : 0;
-    c.two_view_off += mv.size == 2 && error > 0.05 ? 1 : 0;
-  }
+  test::forEachFrontCameraDepth(sim, config, frame, kWellKnownDepthSigma,
+                                [&](const MultiViewFeature& mv, double error, bool /*edge*/) {
+                                  ++c.points;
+                                  c.within += error < 0.02 ? 1 : 0;
+                                  c.off += error > 0.05 ? 1 : 0;
+                                  c.two_view += mv.size == 2 ? 1 : 0;
+                                  c.two_view_off += mv.size == 2 && error > 0.05 ? 1 : 0;
+                                });
   return c;
 }
 
