@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "bilinear_sample.hpp"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #define MCSLAM_ALIGN_HAVE_SSE2 1
@@ -29,14 +31,7 @@ bool inside(const ImageView& im, double x, double y, double ex, double ey) {
 // (x, y) and (x + 1, y + 1) is inside. The portable reference; the vector kernels below compute the same lanes
 // with the same operations in the same order, so all give identical floats.
 void sampleBilinearPortable(const ImageView& im, const float* xs, const float* ys, int count, float* out) {
-  for (int k = 0; k < count; ++k) {
-    const int x0 = static_cast<int>(xs[k]), y0 = static_cast<int>(ys[k]);  // positions are >= 0: truncation floors
-    const float ax = xs[k] - static_cast<float>(x0), ay = ys[k] - static_cast<float>(y0);
-    const uint8_t* p = im.data + static_cast<std::ptrdiff_t>(y0) * im.stride + x0;
-    const float p00 = p[0], p10 = p[1], p01 = p[im.stride], p11 = p[im.stride + 1];
-    const float top = p00 + ax * (p10 - p00), bottom = p01 + ax * (p11 - p01);
-    out[k] = top + ay * (bottom - top);
-  }
+  for (int k = 0; k < count; ++k) out[k] = sampleBilinear(im, xs[k], ys[k]);
 }
 
 // Sums of products over padded arrays, in 4 lanes added in a fixed order (the result does not depend on the

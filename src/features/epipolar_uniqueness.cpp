@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bilinear_sample.hpp"
 #include "mcslam/features/epipolar_alignment.hpp"
 
 namespace mcslam {
@@ -41,12 +42,7 @@ class Strip {
       const float w = static_cast<float>(r - half_);
       const float x = x0_ + u * tx_ - w * ty_, y = y0_ + u * ty_ + w * tx_;
       if (!(x >= 0 && y >= 0 && x < xmax && y < ymax)) return false;
-      const int xi = static_cast<int>(x), yi = static_cast<int>(y);  // non-negative: truncation floors
-      const float ax = x - static_cast<float>(xi), ay = y - static_cast<float>(yi);
-      const uint8_t* p = im_.data + static_cast<std::ptrdiff_t>(yi) * im_.stride + xi;
-      const float p00 = p[0], p10 = p[1], p01 = p[im_.stride], p11 = p[im_.stride + 1];
-      const float top = p00 + ax * (p10 - p00), bottom = p01 + ax * (p11 - p01);
-      out[r] = top + ay * (bottom - top);
+      out[r] = sampleBilinear(im_, x, y);
       s += out[r];
       s2 += out[r] * out[r];
     }
