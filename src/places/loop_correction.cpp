@@ -68,11 +68,6 @@ struct Edges<Sim3> {
   }
 };
 
-SE3 rigidPart(const SE3& T) { return T; }
-SE3 rigidPart(const Sim3& S) { return S.rigid(); }
-double scaleOf(const SE3&) { return 1.0; }
-double scaleOf(const Sim3& S) { return S.s; }
-
 }  // namespace
 
 LoopCorrection::LoopCorrection(int max_keyframes, int max_loops, bool similarity)
@@ -198,8 +193,8 @@ void LoopCorrection::apply(const Graph& graph, PlaceMap& map) {
     if (!k.alive) continue;
     const int node = node_of_slot_[static_cast<std::size_t>(slot)];
     const bool in_graph = k.id < graph_next_id_ && node >= 0 && id_of_node_[static_cast<std::size_t>(node)] == k.id;
-    const Sim3 moved = in_graph ? Sim3(rigidPart(graph.pose(node)), scaleOf(graph.pose(node)))
-                                : segment_delta_[static_cast<std::size_t>(k.segment)] * Sim3(k.T_w_k);
+    const Sim3 moved =
+        in_graph ? Sim3(graph.pose(node)) : segment_delta_[static_cast<std::size_t>(k.segment)] * Sim3(k.T_w_k);
     map.setKeyframePose(slot, moved.rigid());
     if (moved.s != 1.0) map.scaleKeyframe(slot, moved.s);
   }

@@ -15,8 +15,9 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       database_(vocabulary.wordCount(), options.max_keyframes, options.max_words_per_keyframe),
       words_(rig.size(), max_features_per_camera),
       relocalizer_(rig, options, odometry_options.scale_factor, max_features_per_camera),
-      // One camera's maps never have a metric unit: its loops are similarities.
-      loop_closer_(rig, options, odometry_options.scale_factor, max_features_per_camera, rig.size() == 1),
+      // One camera's maps never have a metric unit: its loops, when it closes them, are similarities.
+      loop_closer_(rig, options, odometry_options.scale_factor, max_features_per_camera,
+                   rig.size() == 1 && options.monocular_loop_closure),
       seeds_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
       landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1),
       features_per_camera_(max_features_per_camera),
@@ -158,8 +159,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   // SE(3) closures need a metric map, Sim(3) ones (one camera) a unit that stays put between loops: a map of a
   // rig without overlap whose unit is still being found waits for it.
   const ScaleStatus scale = odometry.rigState().scale();
-  const bool closable = loop_closer_.similarity() ? options_.monocular_loop_closure && scale == ScaleStatus::Monocular
-                                                  : scale == ScaleStatus::Metric;
+  const bool closable = loop_closer_.similarity() ? scale == ScaleStatus::Monocular : scale == ScaleStatus::Metric;
   if (options_.loop_closure && closable) {
     loop_closer_.setRig(odometry.trackingRig());
     loop_closer_.startDetection(slot, kf.features, words_, map_, database_, own_points_);
