@@ -16,17 +16,25 @@ case "${1:-}" in
   *) echo "run-tests: unknown option '$1' (see --help)" >&2; exit 2 ;;
 esac
 
+# Each step says how long it took, so that a CI log shows where its time went (CI has 45 minutes, README).
+step() {
+  local start=$SECONDS
+  "$@"
+  echo "run-tests: $1 took $((SECONDS - start)) s"
+}
+
 if ((ci)); then
-  tools/check-format.sh  # first: it takes seconds, the rest half an hour
-  MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" tools/setup.sh
+  step tools/check-format.sh  # first: it takes seconds, the rest half an hour
+  MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" step tools/setup.sh
 else
   tools/setup.sh
 fi
-ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
+step ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
 if ((ci)); then
-  tools/run-sanitizers.sh all
-  tools/fuzz.sh --ci --runs 5000  # about 3 minutes on two cores, the build included (BENCHMARKS.md, "Fuzzing")
-  # About 12 minutes on two idle cores from a cold cache, with the arm64 root's download (docs/arm64.md).
-  MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" tools/build-arm64.sh arm64-ci
-  tools/test-arm64.sh --subset
+  step tools/run-sanitizers.sh all
+  step tools/fuzz.sh --ci --runs 5000  # about 3 minutes on two cores, the build included (BENCHMARKS.md, "Fuzzing")
+  # About 7 minutes on two idle cores from a cold cache, with the arm64 root's download (docs/arm64.md).
+  MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" step tools/build-arm64.sh arm64-ci
+  step tools/test-arm64.sh --subset
+  echo "run-tests: CI's jobs took $SECONDS s in all"
 fi
