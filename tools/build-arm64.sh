@@ -16,7 +16,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 root="${MCSLAM_ARM64_ROOT:-${HOME}/.cache/mcslam/arm64-root-bookworm}"
-host_packages=(cmake pkg-config ccache file g++-aarch64-linux-gnu qemu-user-static mmdebstrap)
+host_packages=(cmake ninja-build pkg-config ccache file g++-aarch64-linux-gnu qemu-user-static mmdebstrap)
 # tools/setup.sh's libraries, for arm64; libc6-dev and libstdc++-12-dev so that the root is a complete sysroot.
 root_packages=(
   libc6-dev libstdc++-12-dev
@@ -27,6 +27,7 @@ root_packages=(
 
 source tools/install-packages.sh
 install_missing build-arm64 "${host_packages[@]}"
+default_to_ninja
 
 stamp="bookworm arm64 ${root_packages[*]}"
 if [ "$(cat "$root/.mcslam-root" 2>/dev/null)" != "$stamp" ]; then

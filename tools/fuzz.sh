@@ -33,6 +33,7 @@ done
 # Debian 12's clang and its libFuzzer runtime; the libraries' own dependencies come with tools/setup.sh.
 source tools/install-packages.sh
 install_missing fuzz clang libclang-rt-14-dev
+default_to_ninja
 
 build=build-fuzz
 launcher=()

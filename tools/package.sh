@@ -20,6 +20,7 @@ package_args="-DCMAKE_INSTALL_PREFIX=/usr -DMCSLAM_PACKAGE=ON -DMCSLAM_DEB_ARCHI
 build="build-package-$arch"
 source tools/install-packages.sh
 install_missing package help2man  # the manual pages, made from the programs' --help at build time
+default_to_ninja
 if [ "$arch" = arm64 ]; then
   # The multiarch library folder, as the native build's GNUInstallDirs picks on Debian (a cross build does not).
   package_args="$package_args -DCMAKE_INSTALL_LIBDIR=lib/aarch64-linux-gnu"

@@ -20,6 +20,8 @@ for arg in "$@"; do
   esac
 done
 
+source tools/install-packages.sh
+default_to_ninja
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 jobs="$(nproc)"

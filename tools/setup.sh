@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(
-  build-essential cmake pkg-config git python3
+  build-essential cmake ninja-build pkg-config git python3
   libeigen3-dev libopencv-dev libopengv-dev libsuitesparse-dev libspdlog-dev libyaml-cpp-dev libcli11-dev
   libaravis-dev aravis-tools libusb-1.0-0-dev libgpiod-dev
   libgtest-dev libgmock-dev libbenchmark-dev libceres-dev
@@ -13,6 +13,7 @@ packages=(
 )
 source tools/install-packages.sh
 install_missing setup "${packages[@]}"
+default_to_ninja
 
 jobs="$(nproc)"
 # ccache (when installed) makes rebuilds after a checkout or a clean cheap.

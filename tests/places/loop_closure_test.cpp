@@ -64,14 +64,13 @@ class LoopClosure : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = std::make_unique<test::TempDir>("loop_closure");
     std::string out;
-    const std::string sim = test::binPath("mcslam-sim") + " --rig isec --world indoor --no-depth --quiet ";
-    ASSERT_EQ(test::runCommand(sim + "--cameras 0 --frames 11 --out " + dir_->file("start"), &out), 0) << out;
-    writeOutAndBack(readTumTrajectory(dir_->file("start/groundtruth.txt")), dir_->file("route.txt"));
-    ASSERT_EQ(
-        test::runCommand(
-            sim + "--cameras 1,2,3 --trajectory file:" + dir_->file("route.txt") + " --out " + dir_->file("seq"), &out),
-        0)
-        << out;
+    const std::string sim = "--rig isec --world indoor --no-depth --quiet ";
+    const std::string start = test::cachedRender(sim + "--cameras 0 --frames 11", {}, &out);
+    ASSERT_FALSE(start.empty()) << out;
+    const std::string route = dir_->file("route.txt");
+    writeOutAndBack(readTumTrajectory(start + "/groundtruth.txt"), route);
+    seq_ = test::cachedRender(sim + "--cameras 1,2,3 --trajectory file:" + route, {route}, &out);
+    ASSERT_FALSE(seq_.empty()) << out;
   }
   static void TearDownTestSuite() { dir_.reset(); }
 
@@ -82,8 +81,8 @@ class LoopClosure : public ::testing::Test {
   static Run run(const std::string& tag, const std::string& options) {
     Run r;
     const std::string kf = dir_->file(tag + ".kf.tum"), stats = dir_->file(tag + ".json");
-    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") +
-                                   " --quiet --keyframes " + kf + " --stats " + stats + " " + options,
+    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + seq_ + " --quiet --keyframes " + kf +
+                                   " --stats " + stats + " " + options,
                                &r.log),
               0)
         << r.log;
@@ -93,9 +92,11 @@ class LoopClosure : public ::testing::Test {
     return r;
   }
   static std::unique_ptr<test::TempDir> dir_;
+  static std::string seq_;  // the rendered route, shared by the suite's test processes
 };
 
 std::unique_ptr<test::TempDir> LoopClosure::dir_;
+std::string LoopClosure::seq_;
 
 // The rig loses track in both half turns. Relocalized, it is back in the first map's frame at the start (the
 // kidnap test below); so that the loop closer has to join the maps, this run starts a new map at once after a loss
@@ -122,7 +123,7 @@ long expectOnlyTrueClosures(const std::string& log, const std::string& stats, co
 double endError(const Trajectory& keyframes) { return (keyframes.back().T_w_b.t - keyframes.front().T_w_b.t).norm(); }
 
 TEST_F(LoopClosure, TheRouteClosesAtItsStartWithNoFalseClosure) {
-  const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+  const Trajectory gt = readTumTrajectory(seq_ + "/groundtruth.txt");
   const std::string config =
       test::writeFile(dir_->file("no_relocalization.yaml"), "slam:\n  places:\n    relocalization_timeout_s: 0\n");
   const Run closed = run("closed", "--config " + config);
@@ -140,7 +141,7 @@ TEST_F(LoopClosure, TheRouteClosesAtItsStartWithNoFalseClosure) {
 // As mcslamd runs it: the detection and the correction are taken the first frame they are ready (a frame waits only
 // for a detection whose map it must write). The loop still closes, truly, and no thread allocates.
 TEST_F(LoopClosure, TheLiveLoopCloserClosesTheSameRoute) {
-  const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+  const Trajectory gt = readTumTrajectory(seq_ + "/groundtruth.txt");
   const std::string config =
       test::writeFile(dir_->file("no_relocalization.yaml"), "slam:\n  places:\n    relocalization_timeout_s: 0\n");
   const Run live = run("live", "--config " + config + " --live");
@@ -169,7 +170,7 @@ bool trackedAt(const std::string& stats, double t) {
 // memory finds the rig again in the same world frame once it sees the start: standing there at the end, facing as
 // at first, its published pose is the first one's.
 TEST_F(LoopClosure, AKidnappedRigIsNotTrackedFalselyAndIsFoundAgain) {
-  const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+  const Trajectory gt = readTumTrajectory(seq_ + "/groundtruth.txt");
   const Run kidnapped = run("kidnap", "--skip 40-219 --out " + dir_->file("kidnap.tum"));
   const Trajectory published = readTumTrajectory(dir_->file("kidnap.tum"));
   const double kidnap_t = toSeconds(gt[220].t);                           // the first frame after the skipped ones

@@ -28,11 +28,10 @@ class Relocalization : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = std::make_unique<test::TempDir>("relocalization");
     std::string out;
-    const int code =
-        test::runCommand(test::binPath("mcslam-sim") + " --rig isec --cameras 0,1,2,3,4 --world indoor " + "--frames " +
-                             std::to_string(kFrames) + " --no-depth --quiet --out " + dir_->file("seq"),
-                         &out);
-    ASSERT_EQ(code, 0) << out;
+    seq_ = test::cachedRender(
+        "--rig isec --cameras 0,1,2,3,4 --world indoor --frames " + std::to_string(kFrames) + " --no-depth --quiet", {},
+        &out);
+    ASSERT_FALSE(seq_.empty()) << out;
   }
   static void TearDownTestSuite() { dir_.reset(); }
 
@@ -46,8 +45,8 @@ class Relocalization : public ::testing::Test {
     Run r;
     std::string out;
     const std::string traj = dir_->file(tag + ".tum"), stats = dir_->file(tag + ".json");
-    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --out " +
-                                   traj + " --stats " + stats + " " + faults,
+    EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + seq_ + " --quiet --out " + traj +
+                                   " --stats " + stats + " " + faults,
                                &out),
               0)
         << out;
@@ -57,15 +56,17 @@ class Relocalization : public ::testing::Test {
       if (static_cast<int>(i) < lost_first || static_cast<int>(i) > lost_last) measured.push_back(r.trajectory[i]);
     r.stats = test::readFile(stats);
     test::expectRunAllocatedNothing(r.stats);
-    const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+    const Trajectory gt = readTumTrajectory(seq_ + "/groundtruth.txt");
     r.ate = computeApe(gt, measured, EvalOptions{}).stats.rmse;
     return r;
   }
 
   static std::unique_ptr<test::TempDir> dir_;
+  static std::string seq_;  // the rendered sequence, shared by the suite's test processes
 };
 
 std::unique_ptr<test::TempDir> Relocalization::dir_;
+std::string Relocalization::seq_;
 
 TEST_F(Relocalization, AfterABlackoutOnAStraightTheRigIsFoundInTheSameFrame) {
   const Run plain = run("plain", "");
@@ -118,7 +119,7 @@ TEST_F(Relocalization, TheSecondHalfOfARunLocalizesInTheMapTheFirstHalfSaved) {
   Trajectory both = first.trajectory;
   both.insert(both.end(), second.trajectory.begin(), second.trajectory.end());
   EXPECT_GE(second.trajectory.size(), 97u);  // all but the frames before it was recognized
-  const Trajectory gt = readTumTrajectory(dir_->file("seq/groundtruth.txt"));
+  const Trajectory gt = readTumTrajectory(seq_ + "/groundtruth.txt");
   const double ate = computeApe(gt, both, EvalOptions{}).stats.rmse;
   // The goal is "no worse"; the halves are within 10% today (BENCHMARKS.md, "Map reuse").
   EXPECT_LE(ate, 1.1 * plain.ate) << "one run " << plain.ate << ", halves " << first.ate << " and " << second.ate;
@@ -149,15 +150,11 @@ TEST_F(Relocalization, AnUnreadableMapEndsTheRunWithOneMessageNamingIt) {
   const std::string map = dir_->file("broken.map");
   test::writeFile(map, "MCSLMAP");
   std::string out;
-  EXPECT_EQ(test::runCommand(
-                test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --map-in " + map, &out),
-            2);
+  EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + seq_ + " --quiet --map-in " + map, &out), 2);
   EXPECT_NE(out.find("mcslam-run: " + map + ": not an mcslam map file"), std::string::npos) << out;
   EXPECT_EQ(test::runCommand(test::binPath("mcslam-map") + " info " + map, &out), 2);
   EXPECT_NE(out.find("mcslam-map: " + map + ": not an mcslam map file"), std::string::npos) << out;
-  EXPECT_EQ(
-      test::runCommand(test::binPath("mcslam-run") + " --dataset " + dir_->file("seq") + " --quiet --localize", &out),
-      2);
+  EXPECT_EQ(test::runCommand(test::binPath("mcslam-run") + " --dataset " + seq_ + " --quiet --localize", &out), 2);
   EXPECT_NE(out.find("--localize needs a map"), std::string::npos) << out;
 }
 

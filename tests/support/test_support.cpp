@@ -64,6 +64,43 @@ int runCommand(const std::string& command, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+namespace {
+
+uint64_t fnv1a(const std::string& text, uint64_t hash = 14695981039346656037ull) {
+  for (const unsigned char c : text) hash = (hash ^ c) * 1099511628211ull;
+  return hash;
+}
+
+}  // namespace
+
+std::string cachedRender(const std::string& arguments, const std::vector<std::string>& input_files,
+                         std::string* output) {
+  namespace fs = std::filesystem;
+  const fs::path simulator = binPath("mcslam-sim");
+  std::error_code ec;
+  const auto built = fs::last_write_time(simulator, ec);
+  std::string key = arguments;
+  for (const std::string& file : input_files) {
+    const std::size_t at = key.find(file);
+    if (at != std::string::npos) key.replace(at, file.size(), std::to_string(fnv1a(readFile(file))));
+  }
+  key += ec ? std::string("unknown") : std::to_string(built.time_since_epoch().count());
+  const fs::path cache = simulator.parent_path().parent_path() / "test-cache";
+  const fs::path dir = cache / ("render-" + std::to_string(fnv1a(key)));
+  if (fs::exists(dir / "complete")) return dir.string();
+  const fs::path tmp = cache / (dir.filename().string() + ".tmp" + std::to_string(::getpid()));
+  fs::remove_all(tmp, ec);
+  fs::create_directories(cache, ec);
+  if (runCommand(simulator.string() + " " + arguments + " --out " + tmp.string(), output) != 0) {
+    fs::remove_all(tmp, ec);
+    return "";
+  }
+  writeFile((tmp / "complete").string(), "mcslam-sim " + arguments + "\n");
+  fs::rename(tmp, dir, ec);  // another test process may have won the race: then use its folder
+  if (ec) fs::remove_all(tmp, ec);
+  return dir.string();
+}
+
 UdpReceiver::UdpReceiver(uint32_t address, int timeout_ms, int buffer_bytes) {
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (fd_ < 0) return;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace mcslam::test {
 
@@ -34,6 +35,15 @@ std::string readFile(const std::string& path);
 
 // Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
 int runCommand(const std::string& command, std::string* output = nullptr);
+
+// Runs `mcslam-sim <arguments> --out FOLDER` once and returns FOLDER, kept under the build tree (build/test-cache/)
+// for the test processes that follow: ctest runs each test case in its own process, and a suite's rendering can
+// take longer than its checks. The key is the arguments, the contents of `input_files` (paths that appear in the
+// arguments, so that a file written to a temporary folder still finds its rendering) and the simulator's build
+// time, so a rebuilt simulator renders again. A half-written folder is never taken for a finished one. On failure
+// returns an empty string and mcslam-sim's output in *output.
+std::string cachedRender(const std::string& arguments, const std::vector<std::string>& input_files = {},
+                         std::string* output = nullptr);
 
 // A UDP socket bound to `address` (IPv4, host byte order: INADDR_LOOPBACK, INADDR_ANY) on a port the kernel
 // picks, whose receives give up after `timeout_ms`, with a receive buffer of `buffer_bytes` (0: the system's);
