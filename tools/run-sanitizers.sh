@@ -4,8 +4,8 @@
 #
 # Usage: tools/run-sanitizers.sh [--full] [address|thread|all]     (default: all; tools/setup.sh must have run once)
 #   without --full (what CI runs): the suites labelled sanitizer-ci* (tests/CMakeLists.txt: the code that parses
-#                  files, indexes raw memory or owns threads, built from the lower stages only) under ASan+UBSan,
-#                  and those of them that run threads (sanitizer-ci-threads) under TSan.
+#                  files, indexes raw memory or owns threads) under ASan+UBSan, and those of them that run
+#                  threads and build from the lower stages (sanitizer-ci-threads) under TSan.
 #   --full         every suite under ASan+UBSan and every threaded suite under TSan: too long for CI on two cores
 #                  (BENCHMARKS.md, "Sanitizers"); run it before resolving an issue that touches the core.
 set -euo pipefail

@@ -19,8 +19,9 @@ jobs="$(nproc)"
 # ccache (when installed) makes rebuilds after a checkout or a clean cheap.
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
-# MCSLAM_CMAKE_ARGS: extra CMake arguments (tools/run-tests.sh --ci passes -DMCSLAM_WERROR=ON).
+# MCSLAM_CMAKE_ARGS: extra CMake arguments, after ours (tools/run-tests.sh --ci passes -DMCSLAM_WERROR=ON and
+# -DMCSLAM_BUILD_BENCHMARKS=OFF).
 # shellcheck disable=SC2086
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" ${MCSLAM_CMAKE_ARGS:-}
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMCSLAM_BUILD_BENCHMARKS=ON "${launcher[@]}" ${MCSLAM_CMAKE_ARGS:-}
 cmake --build build -j"$jobs"
 echo "setup: built; executables are in build/bin"
