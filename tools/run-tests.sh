@@ -33,7 +33,7 @@ fi
 step ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
 if ((ci)); then
   step tools/run-sanitizers.sh all
-  step tools/fuzz.sh --ci --runs 5000  # about 3 minutes on two cores, the build included (BENCHMARKS.md, "Fuzzing")
+  step tools/fuzz.sh --ci --runs 5000  # under 2 minutes on two idle cores, the build included (BENCHMARKS.md, "Fuzzing")
   # About 7 minutes on two idle cores from a cold cache, with the arm64 root's download (docs/arm64.md).
   MCSLAM_CMAKE_ARGS="-DMCSLAM_WERROR=ON" step tools/build-arm64.sh arm64-ci
   step tools/test-arm64.sh --subset
