@@ -2,10 +2,8 @@
 // A rendered simulator dataset for the daemon tests and benchmarks with the real pipeline: the ISEC rig's
 // five overlapping front cameras in the indoor world, ground robot, seed 1, written with exportDataset
 // (camchain.yaml, images, groundtruth.txt). Rendering costs seconds, so it is cached under the build
-// tree (build/test-cache/<name>) and reused; a half-written folder is never taken for a finished one. The name
-// carries the build time of the simulator library, so a rebuilt renderer never meets images of an older one.
-#include <unistd.h>
-
+// tree (test::cachedFolder). The name carries the build time of the simulator library, so a rebuilt renderer never
+// meets images of an older one.
 #include <filesystem>
 #include <string>
 
@@ -25,24 +23,17 @@ inline std::string cachedSimDataset(int frames = kSimDatasetFrames, double rate_
   const std::string name = "daemon-isec5-indoor-ground-" + std::to_string(frames) + "-at-" +
                            std::to_string(static_cast<int>(rate_hz * 1000)) + "mHz-sim" +
                            (ec ? std::string("unknown") : std::to_string(renderer_built.time_since_epoch().count()));
-  const fs::path cache = build / "test-cache";
-  const fs::path dir = cache / name;
-  if (fs::exists(dir / "complete")) return dir.string();
-  sim::SimulationConfig cfg;  // isec, indoor, ground, seed 1
-  cfg.frames = frames;
-  cfg.rate_hz = rate_hz;
-  sim::Simulation simulation(cfg);
-  sim::ExportOptions options;
-  options.cameras = {0, 1, 2, 3, 4};
-  options.depth = false;
-  const fs::path tmp = cache / (name + ".tmp" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  fs::create_directories(tmp);
-  sim::exportDataset(simulation, tmp.string(), options);
-  writeFile((tmp / "complete").string(), "rendered by tests/platform/sim_dataset_fixture.hpp\n");
-  fs::rename(tmp, dir, ec);  // another test process may have won the race: then use its folder
-  if (ec) fs::remove_all(tmp);
-  return dir.string();
+  return cachedFolder(name, [&](const std::string& folder) {
+    sim::SimulationConfig cfg;  // isec, indoor, ground, seed 1
+    cfg.frames = frames;
+    cfg.rate_hz = rate_hz;
+    sim::Simulation simulation(cfg);
+    sim::ExportOptions options;
+    options.cameras = {0, 1, 2, 3, 4};
+    options.depth = false;
+    sim::exportDataset(simulation, folder, options);
+    return true;
+  });
 }
 
 }  // namespace mcslam::test

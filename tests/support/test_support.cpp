@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -73,32 +74,39 @@ uint64_t fnv1a(const std::string& text, uint64_t hash = 14695981039346656037ull)
 
 }  // namespace
 
+std::string cachedFolder(const std::string& name, const std::function<bool(const std::string& folder)>& fill) {
+  namespace fs = std::filesystem;
+  const fs::path cache = fs::path(MCSLAM_BIN_DIR).parent_path() / "test-cache";
+  const fs::path dir = cache / name;
+  if (fs::exists(dir / "complete")) return dir.string();
+  std::error_code ec;
+  const fs::path tmp = cache / (name + ".tmp" + std::to_string(::getpid()));
+  fs::remove_all(tmp, ec);
+  fs::create_directories(tmp, ec);
+  if (!fill(tmp.string())) {
+    fs::remove_all(tmp, ec);
+    return "";
+  }
+  writeFile((tmp / "complete").string(), name + "\n");
+  fs::rename(tmp, dir, ec);  // another test process may have won the race: then use its folder
+  if (ec) fs::remove_all(tmp, ec);
+  return dir.string();
+}
+
 std::string cachedRender(const std::string& arguments, const std::vector<std::string>& input_files,
                          std::string* output) {
-  namespace fs = std::filesystem;
-  const fs::path simulator = binPath("mcslam-sim");
+  const std::string simulator = binPath("mcslam-sim");
   std::error_code ec;
-  const auto built = fs::last_write_time(simulator, ec);
+  const auto built = std::filesystem::last_write_time(simulator, ec);
   std::string key = arguments;
   for (const std::string& file : input_files) {
     const std::size_t at = key.find(file);
     if (at != std::string::npos) key.replace(at, file.size(), std::to_string(fnv1a(readFile(file))));
   }
   key += ec ? std::string("unknown") : std::to_string(built.time_since_epoch().count());
-  const fs::path cache = simulator.parent_path().parent_path() / "test-cache";
-  const fs::path dir = cache / ("render-" + std::to_string(fnv1a(key)));
-  if (fs::exists(dir / "complete")) return dir.string();
-  const fs::path tmp = cache / (dir.filename().string() + ".tmp" + std::to_string(::getpid()));
-  fs::remove_all(tmp, ec);
-  fs::create_directories(cache, ec);
-  if (runCommand(simulator.string() + " " + arguments + " --out " + tmp.string(), output) != 0) {
-    fs::remove_all(tmp, ec);
-    return "";
-  }
-  writeFile((tmp / "complete").string(), "mcslam-sim " + arguments + "\n");
-  fs::rename(tmp, dir, ec);  // another test process may have won the race: then use its folder
-  if (ec) fs::remove_all(tmp, ec);
-  return dir.string();
+  return cachedFolder("render-" + std::to_string(fnv1a(key)), [&](const std::string& folder) {
+    return runCommand(simulator + " " + arguments + " --out " + folder, output) == 0;
+  });
 }
 
 UdpReceiver::UdpReceiver(uint32_t address, int timeout_ms, int buffer_bytes) {

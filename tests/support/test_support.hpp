@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,11 +37,15 @@ std::string readFile(const std::string& path);
 // Runs a shell command, returns its exit code; stdout+stderr go to *output when given.
 int runCommand(const std::string& command, std::string* output = nullptr);
 
-// Runs `mcslam-sim <arguments> --out FOLDER` once and returns FOLDER, kept under the build tree (build/test-cache/)
-// for the test processes that follow: ctest runs each test case in its own process, and a suite's rendering can
-// take longer than its checks. The key is the arguments, the contents of `input_files` (paths that appear in the
-// arguments, so that a file written to a temporary folder still finds its rendering) and the simulator's build
-// time, so a rebuilt simulator renders again. A half-written folder is never taken for a finished one. On failure
+// build/test-cache/<name>, made once by `fill` (given a fresh folder to fill, returns whether it succeeded) and
+// kept for the test processes that follow: ctest runs each test case in its own process, and making the data
+// (rendering) can take longer than the checks. A half-written folder is never taken for a finished one, and of two
+// processes making it at once, one's folder is kept. An empty string when `fill` failed.
+std::string cachedFolder(const std::string& name, const std::function<bool(const std::string& folder)>& fill);
+
+// The folder `mcslam-sim <arguments> --out FOLDER` writes, made once (cachedFolder). The key is the arguments, the
+// contents of `input_files` (paths that appear in the arguments, so that a file written to a temporary folder
+// still finds its rendering) and the simulator's build time, so a rebuilt simulator renders again. On failure
 // returns an empty string and mcslam-sim's output in *output.
 std::string cachedRender(const std::string& arguments, const std::vector<std::string>& input_files = {},
                          std::string* output = nullptr);

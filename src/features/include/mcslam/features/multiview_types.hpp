@@ -37,9 +37,8 @@ struct MultiViewOptions {
   // With the alignment: a track left with two views is dropped when, further along the partner's epipolar curve
   // (depths the matcher accepts), a place that looks like the partner aligns to the reference at least as well
   // as the partner did: the partner may be a repetition of an undetected true one, and no third ray checks its
-  // depth (TrackBuilder::ambiguousPair()). Tracks of three or more views are not checked. Off by default: what it
-  // removes on repeating texture it has not yet repaid in accuracy on real frames, and it costs CPU on every
-  // frame (BENCHMARKS.md section 3, "Repeating texture").
+  // depth (TrackBuilder::ambiguousPair()). Tracks of three or more views are not checked. Off by default: it
+  // costs CPU on every frame (BENCHMARKS.md section 3, "Repeating texture").
   bool unique_two_view = false;
   EpipolarAlignmentOptions alignment;
 

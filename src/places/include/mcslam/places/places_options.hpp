@@ -29,9 +29,9 @@ struct PlacesOptions {
 
   // Loop closure.
   bool loop_closure = true;
-  // One camera's loops, in Sim(3). Off by default: one camera's unit jumps where tracking nearly fails, and a pose
-  // graph alone spreads a loop's scale evenly over the loop (BENCHMARKS.md section 10, "Sim(3) loop closure").
-  // Joining one camera's maps after a loss needs it.
+  // One camera's loops, in Sim(3). Off by default: a pose graph spreads a loop's scale correction evenly over
+  // the loop, wherever the unit changed (BENCHMARKS.md section 10, "Sim(3) loop closure"). Joining one camera's
+  // maps after a loss needs it.
   bool monocular_loop_closure = false;
   int loop_min_keyframes_apart = 30;  // an older keyframe of the same segment is a loop candidate only this far back
   int max_loops = 500;                // loop edges kept in the pose graph
