@@ -1,7 +1,7 @@
 #pragma once
-// Four-lane float and int vectors (GCC vector extensions: plain SSE2 on x86-64, no target-specific intrinsics,
-// so the build stays portable). The renderer works on four neighbouring pixels at a time: their rays share the
-// camera centre, the tile's candidates and, most of the time, the surface they hit.
+// Four-lane float and int vectors (GCC vector extensions, which clang shares: plain SSE2 on x86-64, no target-specific
+// intrinsics, so the build stays portable). The renderer works on four neighbouring pixels at a time: their rays share
+// the camera centre, the tile's candidates and, most of the time, the surface they hit.
 #include <cstdint>
 #include <cstring>
 
@@ -80,22 +80,23 @@ inline f4 gatherBytes(const uint8_t* base, i4 idx) {
 }
 // Four rows (x, y, z, w) -> four columns: xs, ys, zs, ws.
 inline void transpose4(const f4 r[4], f4 c[4]) {
-  const i4 lo = {0, 4, 1, 5}, hi = {2, 6, 3, 7}, first = {0, 1, 4, 5}, second = {2, 3, 6, 7};
-  const f4 xy01 = __builtin_shuffle(r[0], r[1], lo), xy23 = __builtin_shuffle(r[2], r[3], lo);
-  const f4 zw01 = __builtin_shuffle(r[0], r[1], hi), zw23 = __builtin_shuffle(r[2], r[3], hi);
-  c[0] = __builtin_shuffle(xy01, xy23, first);
-  c[1] = __builtin_shuffle(xy01, xy23, second);
-  c[2] = __builtin_shuffle(zw01, zw23, first);
-  c[3] = __builtin_shuffle(zw01, zw23, second);
+  const f4 xy01 = __builtin_shufflevector(r[0], r[1], 0, 4, 1, 5),
+           xy23 = __builtin_shufflevector(r[2], r[3], 0, 4, 1, 5);
+  const f4 zw01 = __builtin_shufflevector(r[0], r[1], 2, 6, 3, 7),
+           zw23 = __builtin_shufflevector(r[2], r[3], 2, 6, 3, 7);
+  c[0] = __builtin_shufflevector(xy01, xy23, 0, 1, 4, 5);
+  c[1] = __builtin_shufflevector(xy01, xy23, 2, 3, 6, 7);
+  c[2] = __builtin_shufflevector(zw01, zw23, 0, 1, 4, 5);
+  c[3] = __builtin_shufflevector(zw01, zw23, 2, 3, 6, 7);
 }
 
 // Whether any lane of a comparison result is true; the largest lane.
 inline bool any(i4 m) {
-  const i4 folded = m | __builtin_shuffle(m, i4{2, 3, 0, 1});
+  const i4 folded = m | __builtin_shufflevector(m, m, 2, 3, 0, 1);
   return (folded[0] | folded[1]) != 0;
 }
 inline float hmax(f4 a) {
-  const f4 folded = vmax(a, __builtin_shuffle(a, i4{2, 3, 0, 1}));
+  const f4 folded = vmax(a, __builtin_shufflevector(a, a, 2, 3, 0, 1));
   return folded[0] > folded[1] ? folded[0] : folded[1];
 }
 inline float sum(f4 a) { return (a[0] + a[1]) + (a[2] + a[3]); }
