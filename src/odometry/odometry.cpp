@@ -77,7 +77,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   if (!loss_clock_.frame(frame.t)) noteStampNotIncreasing(frame, frame_index);
   settled_count_ = 0;
   rescale_count_ = 0;
-  flush();                                // the previous keyframe's solve, before this frame reads the map
+  applyDueSolve();
   tracker_->follow(bridge_->rigState());  // a frame boundary: tracking takes the rig state as it is now
   const auto start = Clock::now();
   const double flushed_ms = timing_.mapping_ms + timing_.backend_ms;
@@ -107,8 +107,8 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   lost_frames_ = 0;
   ++stats_.tracking;
   stats_.recoveries = tracker_->recoveries();
-  if (extrinsic_check_) {
-    // No solve runs now (flush() came first): the back-end's estimate may be replaced.
+  if (extrinsic_check_ && !bridge_->solving()) {
+    // No solve runs now: the back-end's estimate may be replaced.
     SE3 T_b_c;
     const int cam = extrinsic_check_->check(map_, tracker_->search(), bridge_->rigState().rig(), frame,
                                             tracker_->matches(), T_w_b, T_b_c);
@@ -120,7 +120,13 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   tracker_->advance(T_w_b);
   timing_.tracking_ms = msSince(start);
 
-  if (tracker_->needKeyframe(map_, T_w_b, inliers, frame_index)) makeKeyframe(frame, frame_index, T_w_b, inliers, out);
+  if (tracker_->needKeyframe(map_, T_w_b, inliers, frame_index)) {
+    if (pending_keyframe_ >= 0) {
+      flush();  // the new keyframe joins the solved map, at this frame's pose moved with it
+      T_w_b = tracker_->pose();
+    }
+    makeKeyframe(frame, frame_index, T_w_b, inliers, out);
+  }
   tracker_->rememberTracked(map_, frame, frame_index);
   if (!out.is_keyframe) spdlog::trace("odometry: frame {}: {} inliers", frame_index, inliers);
   out.T_w_b = tracker_->pose();
@@ -165,7 +171,10 @@ void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, co
   spdlog::trace("odometry: frame {}: keyframe, {} inliers, {} new landmarks", frame_index, inliers, created);
   timing_.mapping_ms = msSince(map_start);
   const auto be_start = Clock::now();
-  if (bridge_->beginSolve(map_, slot)) pending_keyframe_ = slot;
+  if (bridge_->beginSolve(map_, slot)) {
+    pending_keyframe_ = slot;
+    pending_frames_ = 0;
+  }
   timing_.backend_ms = msSince(be_start);
   tracker_->keyframeMade(frame_index, T_w_b);
   ++stats_.keyframes;
@@ -196,6 +205,12 @@ void Odometry::flush() {
   }
   timing_.backend_ms += msSince(start);
   finishKeyframe(slot);  // its culling counts as mapping
+}
+
+void Odometry::applyDueSolve() {
+  if (pending_keyframe_ < 0) return;
+  ++pending_frames_;
+  if (pending_frames_ >= apply_after_frames_ || !initialized_ || lost_frames_ > 0) flush();
 }
 
 void Odometry::finishKeyframe(int slot) {
@@ -282,6 +297,9 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstim
   // constrains it. resetMap() lets it go.
   if (!metric && cams > 1) bridge_->holdScale(true);
   triangulator_->setSceneReferencedPoints(!metric || cams == 1);
+  // A map whose unit rests on its window (one camera, or no overlap before the scale is found) tracks on solved
+  // maps only: later solves made those runs markedly worse (BENCHMARKS.md section 7).
+  apply_after_frames_ = metric && cams > 1 ? options_.backend_apply_after_frames : 1;
   scale_->start(!metric);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
   ++stats_.keyframes;

@@ -193,11 +193,13 @@ void Tracker::advance(const SE3& T_w_b) {
   have_velocity_ = true;
   rotation_travelled_ += rotationAngle(T_w_last_.R, T_w_b.R);
   T_w_last_ = T_w_b;
+  moved_since_keyframe_ = true;
 }
 
 const SE3& Tracker::coast() {
   // The trajectory stays continuous through a loss.
   T_w_last_ = have_velocity_ ? T_w_last_ * velocity_ : T_w_last_;
+  moved_since_keyframe_ = true;
   return T_w_last_;
 }
 
@@ -227,8 +229,10 @@ int Tracker::countKeyframeLandmarks(const Map& map, int slot) const {
 }
 
 void Tracker::keyframeSettled(const Map& map, int slot) {
-  T_w_last_ = map.keyframe(slot).T_w_b;
-  last_keyframe_pose_ = T_w_last_;
+  const SE3& settled = map.keyframe(slot).T_w_b;
+  // Frames tracked since the keyframe were tracked against the map before its solve: they move with the keyframe.
+  T_w_last_ = moved_since_keyframe_ ? settled * last_keyframe_pose_.inverse() * T_w_last_ : settled;
+  last_keyframe_pose_ = settled;
   last_keyframe_tracked_ = countKeyframeLandmarks(map, slot);
   int kept = 0;
   for (int i = 0; i < last_tracked_count_; ++i) {
@@ -253,6 +257,7 @@ void Tracker::rememberTracked(const Map& map, const FrameFeatures& frame, uint64
 
 void Tracker::startFrom(const Map& map, int slot, uint64_t frame_index) {
   T_w_last_ = map.keyframe(slot).T_w_b;
+  moved_since_keyframe_ = false;
   have_velocity_ = false;
   last_keyframe_frame_ = frame_index;
   last_keyframe_pose_ = T_w_last_;

@@ -96,6 +96,7 @@ void readBackend(ConfigSection s, PipelineConfig& c) {
   s.read("enabled", o.backend);
   s.read("iterations", o.backend_iterations, 1, 100);
   s.read("thread", o.backend_thread);
+  s.read("apply_after_frames", o.backend_apply_after_frames, 1, 10);
   readRefineExtrinsics(s, c.refine_extrinsics);
   s.read("extrinsic_sigma_translation", o.extrinsic_sigma_translation, 1e-6, 1.0);
   s.read("extrinsic_sigma_rotation_deg", o.extrinsic_sigma_rotation_deg, 1e-4, 45.0);
@@ -233,6 +234,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    enabled: " << (o.backend ? "true" : "false") << "\n"
      << "    iterations: " << o.backend_iterations << "\n"
      << "    thread: " << (o.backend_thread ? "true" : "false") << "\n"
+     << "    apply_after_frames: " << o.backend_apply_after_frames << "\n"
      << "    refine_extrinsics: " << refineExtrinsicsName(c.refine_extrinsics) << "\n"
      << "    extrinsic_sigma_translation: " << o.extrinsic_sigma_translation << "\n"
      << "    extrinsic_sigma_rotation_deg: " << o.extrinsic_sigma_rotation_deg << "\n"

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -27,17 +28,18 @@ struct RunResult {
   int first_metric = -1;                                    // first tracked frame whose pose says it is metric
   int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
   std::vector<float> quality;                               // per frame (0 when not tracked)
+  std::vector<int> keyframe_frames;                         // frames that made a keyframe (is_keyframe)
+  std::vector<int> settled_frames;                          // frames after which a keyframe was settled, once each
 };
 
 // Changes frame i's features before they are processed (a camera that did not deliver, say).
 using FrameChange = std::function<void(int, FrameFeatures&)>;
 
 RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, bool sim3,
-                      const FrameChange& change = {}) {
+                      const FrameChange& change = {}, const OdometryOptions& oo = {}) {
   test::SyntheticSequence seq(rig, so);
   OverlapMap overlap(rig, OverlapOptions{});
   MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
-  OdometryOptions oo;
   Odometry odo(rig, oo, so.max_features);
   FrameFeatures f(rig.size(), so.max_features);
   RunResult r;
@@ -56,6 +58,8 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
       if (scope.count() && std::getenv("MCSLAM_DEBUG_ALLOC"))
         std::printf("frame %d allocs %llu\n", i, (unsigned long long)scope.count());
     }
+    if (pose.is_keyframe) r.keyframe_frames.push_back(i);
+    for (std::size_t k = 0; k < odo.settledKeyframes().size(); ++k) r.settled_frames.push_back(i);
     if (pose.valid && pose.state == TrackingState::Tracking) {
       r.quality[static_cast<std::size_t>(i)] = pose.quality;
       r.estimate.push_back({pose.t, pose.T_w_b});
@@ -91,6 +95,47 @@ TEST(OdometrySynthetic, FiveOverlappingCameras) {
   if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);  // keyframes, mapping and back-end (its thread too) included
   }
+}
+
+// A keyframe's solve runs beside the next frames and is applied before frame keyframe + backend_apply_after_frames,
+// or at once when a new keyframe comes first: at fixed frames, whatever the solve's time. 1 applies it before the
+// very next frame; so does a map started up to scale (`applied_after`: what the rig's map uses).
+static void expectSolvesAppliedAt(const Rig& rig, int apply_after_frames, int applied_after, double max_ate) {
+  test::SyntheticSequenceOptions so;
+  OdometryOptions oo;
+  oo.backend_apply_after_frames = apply_after_frames;
+  const RunResult r = runSequence(rig, so, rig.size() == 1, {}, oo);
+  EXPECT_EQ(r.stats.lost, 0u);
+  EXPECT_LT(r.ate, max_ate);
+  // The first keyframes (the map's start) are settled in the frame that makes them; each later one in the frame
+  // its solve is applied in.
+  ASSERT_GE(r.keyframe_frames.size(), 10u);
+  const int start = r.keyframe_frames[0];
+  std::vector<int> expected;
+  for (std::size_t k = 0; k < r.keyframe_frames.size(); ++k) {
+    const int kf = r.keyframe_frames[k];
+    if (kf == start) {
+      expected.push_back(kf);
+      continue;
+    }
+    const int next = k + 1 < r.keyframe_frames.size() ? r.keyframe_frames[k + 1] : so.frames;
+    // Due before frame kf + n; a keyframe made earlier applies it first, in its own frame (the last one at the end
+    // of the run is applied by flush(), after every frame: not counted).
+    if (std::min(kf + applied_after, next) < so.frames) expected.push_back(std::min(kf + applied_after, next));
+  }
+  std::vector<int> settled = r.settled_frames;
+  settled.erase(std::remove(settled.begin() + 1, settled.end(), start), settled.end());  // the start's, counted once
+  EXPECT_EQ(settled, expected);
+}
+
+TEST(OdometrySynthetic, AKeyframesSolveIsAppliedBeforeTheNextFrame) {
+  expectSolvesAppliedAt(test::isecRig(), 1, 1, 0.05);
+}
+TEST(OdometrySynthetic, AKeyframesSolveIsAppliedThreeFramesLaterOrAtTheNextKeyframe) {
+  expectSolvesAppliedAt(test::isecRig(), 3, 3, 0.05);
+}
+TEST(OdometrySynthetic, OneCamerasMapAppliesEverySolveBeforeTheNextFrame) {
+  expectSolvesAppliedAt(test::isecRig().subset({2}), 3, 1, 0.5);
 }
 
 double meanQuality(const RunResult& r, int first, int last) {

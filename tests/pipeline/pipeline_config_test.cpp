@@ -31,12 +31,14 @@ TEST(PipelineConfig, AbsentSectionGivesDefaults) {
 }
 
 TEST(PipelineConfig, EffectiveConfigReadsBackToTheSameValues) {
-  const PipelineConfig c =
-      parsePipelineConfig(YAML::Load("features: {levels: 6}\ntracking: {radius_px: 22}"), "x.yaml", isec());
+  const PipelineConfig c = parsePipelineConfig(
+      YAML::Load("features: {levels: 6}\ntracking: {radius_px: 22}\nbackend: {apply_after_frames: 5}"), "x.yaml",
+      isec());
   const YAML::Node back = YAML::Load(formatPipelineConfig(c));
   const PipelineConfig d = parsePipelineConfig(back["slam"], "effective", isec());
   EXPECT_EQ(d.orb.levels, 6);
   EXPECT_DOUBLE_EQ(d.odometry.track_radius_px, 22);
+  EXPECT_EQ(d.odometry.backend_apply_after_frames, 5);
   EXPECT_EQ(formatPipelineConfig(d), formatPipelineConfig(c));
 }
 
@@ -47,6 +49,7 @@ TEST(PipelineConfig, BadValuesNameFileAndKey) {
             std::string::npos);
   EXPECT_NE(errorOf("tracking: {ratio: high}").find("slam.tracking.ratio"), std::string::npos);
   EXPECT_NE(errorOf("backend: {refine_extrinsics: maybe}").find("auto, on, off"), std::string::npos);
+  EXPECT_NE(errorOf("backend: {apply_after_frames: 0}").find("slam.backend.apply_after_frames"), std::string::npos);
   EXPECT_NE(errorOf("features: [1, 2]").find("slam.features: must be a map"), std::string::npos);
   EXPECT_NE(errorOf("capacity: {max_keyframes: 8, window_keyframes: 8}").find("max_keyframes"), std::string::npos);
   EXPECT_NE(errorOf("multiview: {min_depth: 5, max_depth: 2}").find("max_depth"), std::string::npos);

@@ -125,6 +125,9 @@ class Odometry {
   // New landmarks across time for keyframe `slot` (TemporalTriangulator); returns how many.
   int triangulateNew(int slot);
   void finishKeyframe(int slot);
+  // At the start of a frame: the pending solve is applied when it is due (backend_apply_after_frames), or at once
+  // when this frame will not simply be tracked against the map.
+  void applyDueSolve();
   void noteSettled(int slot);  // culling and the state that follows the (optimized) keyframe pose
   void resetMap();
   void clearMap();  // the map, the mapper's pending work and the window
@@ -143,8 +146,10 @@ class Odometry {
   std::unique_ptr<ScaleSupervisor> scale_;
 
   bool initialized_ = false;
-  SE3 anchor_;                 // pose given to the next initialization (continuity after a loss)
-  int pending_keyframe_ = -1;  // keyframe whose back-end solve has not been applied yet
+  SE3 anchor_;                  // pose given to the next initialization (continuity after a loss)
+  int pending_keyframe_ = -1;   // keyframe whose back-end solve has not been applied yet
+  int pending_frames_ = 0;      // frames begun since that solve started
+  int apply_after_frames_ = 1;  // of this map (OdometryOptions::backend_apply_after_frames where it applies)
   int lost_frames_ = 0;
   LossClock loss_clock_;
   std::array<int32_t, 4> settled_{};

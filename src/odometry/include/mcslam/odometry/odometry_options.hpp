@@ -76,10 +76,14 @@ struct OdometryOptions {
   // Back-end.
   bool backend = true;
   int backend_iterations = 6;
-  // The solve runs on a thread of its own while tracking goes on with the next frame; its result is applied
-  // before that frame touches the map, so the output does not depend on timing. A keyframe's own pose is then
-  // the tracked one (the optimized pose is what the following frames continue from).
+  // The solve runs on a thread of its own while tracking goes on with the next frames; its result is applied at a
+  // fixed frame, so the output does not depend on timing. A keyframe's own pose is then the tracked one (the
+  // optimized pose is what the following frames continue from).
   bool backend_thread = true;
+  // The frame, counted from the keyframe, before which its solve is applied (1: the next one), for maps that start
+  // metric (cameras that overlap). Later spreads the solve over more frame periods instead of stalling one frame
+  // for it; a new keyframe, a loss or a new map applies it at once. A map started up to scale always uses 1.
+  int backend_apply_after_frames = 3;
   bool refine_extrinsics = false;
   double extrinsic_sigma_translation = 0.02;  // metres
   double extrinsic_sigma_rotation_deg = 1.0;

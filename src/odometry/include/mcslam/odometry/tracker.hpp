@@ -37,9 +37,11 @@ class Tracker {
   void keyframeMade(uint64_t frame_index, const SE3& T_w_b) {
     last_keyframe_frame_ = frame_index;
     last_keyframe_pose_ = T_w_b;
+    moved_since_keyframe_ = false;
   }
-  // Keyframe `slot` is final (optimized, culled): the next frames continue from its pose, with the same velocity,
-  // and landmarks the back-end or the culling erased are no longer tracked.
+  // Keyframe `slot` is final (optimized, culled): the next frames continue from its pose, with the same velocity
+  // (frames tracked since it move with the keyframe's correction), and landmarks the back-end or the culling erased
+  // are no longer tracked.
   void keyframeSettled(const Map& map, int slot);
   // The landmarks matched in this frame become the first attempt's list for the next one.
   void rememberTracked(const Map& map, const FrameFeatures& frame, uint64_t frame_index);
@@ -91,6 +93,7 @@ class Tracker {
   SE3 velocity_;  // relative motion of the last frame step
   uint64_t last_keyframe_frame_ = 0;
   SE3 last_keyframe_pose_;
+  bool moved_since_keyframe_ = false;  // T_w_last_ is a frame after the last keyframe, not the keyframe itself
   int last_keyframe_tracked_ = 0;
   int expected_matches_ = 0;  // of the last frame: what the local map predicted in the images (the quality's base)
   double rotation_travelled_ = 0;
