@@ -83,7 +83,7 @@ struct OdometryOptions {
   // The frame, counted from the keyframe, before which its solve is applied (1: the next one), for maps that start
   // metric (cameras that overlap). Later spreads the solve over more frame periods instead of stalling one frame
   // for it; a new keyframe, a loss or a new map applies it at once. A map started up to scale always uses 1.
-  int backend_apply_after_frames = 3;
+  int backend_apply_after_frames = 2;
   bool refine_extrinsics = false;
   double extrinsic_sigma_translation = 0.02;  // metres
   double extrinsic_sigma_rotation_deg = 1.0;
