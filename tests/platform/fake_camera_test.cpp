@@ -42,8 +42,15 @@ class FakeCamera {
     }
   }
   ~FakeCamera() {
+    // arv-fake-gv-camera does not always end on SIGTERM, and a test must not wait for ever: a few seconds, then
+    // SIGKILL.
     ::kill(pid_, SIGTERM);
     int status;
+    for (int i = 0; i < 100; ++i) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ::kill(pid_, SIGKILL);
     ::waitpid(pid_, &status, 0);
   }
   // Liveness: until the camera answers on its control channel.
