@@ -82,8 +82,9 @@ struct OdometryOptions {
   bool backend_thread = true;
   // The frame, counted from the keyframe, before which its solve is applied (1: the next one), for maps that start
   // metric (cameras that overlap). Later spreads the solve over more frame periods instead of stalling one frame
-  // for it; a new keyframe, a loss or a new map applies it at once. A map started up to scale always uses 1.
-  int backend_apply_after_frames = 2;
+  // for it, but the frames between are tracked against the map before the solve; a new keyframe, a loss or a new
+  // map applies it at once. A map started up to scale always uses 1.
+  int backend_apply_after_frames = 1;
   bool refine_extrinsics = false;
   double extrinsic_sigma_translation = 0.02;  // metres
   double extrinsic_sigma_rotation_deg = 1.0;
