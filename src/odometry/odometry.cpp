@@ -298,7 +298,7 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstim
   if (!metric && cams > 1) bridge_->holdScale(true);
   triangulator_->setSceneReferencedPoints(!metric || cams == 1);
   // A map whose unit rests on its window (one camera, or no overlap before the scale is found) tracks on solved
-  // maps only: later solves made those runs markedly worse (BENCHMARKS.md section 7).
+  // maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
   apply_after_frames_ = metric && cams > 1 ? options_.backend_apply_after_frames : 1;
   scale_->start(!metric);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found

@@ -29,7 +29,7 @@ struct RunResult {
   int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
   std::vector<float> quality;                               // per frame (0 when not tracked)
   std::vector<int> keyframe_frames;                         // frames that made a keyframe (is_keyframe)
-  std::vector<int> settled_frames;                          // frames after which a keyframe was settled, once each
+  std::vector<int> settled_frames;                          // frames in which a keyframe was settled, one per keyframe
 };
 
 // Changes frame i's features before they are processed (a camera that did not deliver, say).
