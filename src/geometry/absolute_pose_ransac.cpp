@@ -143,6 +143,20 @@ AbsolutePoseRansacResult AbsolutePoseRansac::estimate(std::span<const PoseObserv
     }
     num_inliers = classify(obs, best);
   }
+  if (options_.refine && predicted_T_w_b) {
+    // The prediction refined over every correspondence, against the winner: when most points are far, a
+    // hypothesis off along the translation the points barely constrain (and the rotation that hides it) keeps
+    // most of them, and the adaptive stop takes it after a few samples; the near points it lost then decide.
+    const PoseRefinementResult refined = refiner_.refine(obs, *predicted_T_w_b);
+    if (refined.success) {
+      const int refined_inliers = classify(obs, refined.T_w_b);
+      if (refined_inliers > num_inliers) {
+        best = refined.T_w_b;
+        result.from_prediction = true;
+      }
+      num_inliers = classify(obs, best);
+    }
+  }
   result.T_w_b = best;
   result.num_inliers = num_inliers;
   result.inlier_mask = std::span<const uint8_t>(inliers_.data(), n);
