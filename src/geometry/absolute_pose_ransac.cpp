@@ -144,9 +144,7 @@ AbsolutePoseRansacResult AbsolutePoseRansac::estimate(std::span<const PoseObserv
     num_inliers = classify(obs, best);
   }
   if (options_.refine && predicted_T_w_b) {
-    // The prediction refined over every correspondence, against the winner: when most points are far, a
-    // hypothesis off along the translation the points barely constrain (and the rotation that hides it) keeps
-    // most of them, and the adaptive stop takes it after a few samples; the near points it lost then decide.
+    // Against the winner (see the header): the near points a nearly degenerate winner lost decide.
     const PoseRefinementResult refined = refiner_.refine(obs, *predicted_T_w_b);
     if (refined.success) {
       const int refined_inliers = classify(obs, refined.T_w_b);

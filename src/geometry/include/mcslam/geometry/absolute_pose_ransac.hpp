@@ -8,6 +8,9 @@
 // The number of samples adapts to the best inlier ratio (confidence), capped by max_iterations.
 // The motion-model prediction, when given, is scored first as one more hypothesis. The winner is
 // refined on its inliers (PoseRefiner) and the inliers are then re-classified at the refined pose.
+// The prediction is also refined over every correspondence and replaces the winner when it keeps more
+// inliers: with mostly far points, a sample can give a pose off along a direction they barely
+// constrain that still keeps most of them, and the adaptive stop takes it.
 #include <cstdint>
 #include <span>
 #include <vector>
