@@ -1,38 +1,68 @@
 #!/usr/bin/env bash
-# Checks the Debian package the way a robot builder meets it, in a clean Debian 12 root (made once with mmdebstrap,
-# kept in ~/.cache/mcslam/; unpacked afresh for every check): install with apt (its dependencies from Debian), the
-# files (manual pages included) and the system user in place, mcslamd started as systemd starts it (the unit's
-# ExecStart, as the unit's user, with $STATE_DIRECTORY; systemd itself cannot run in a chroot, so neither the sandbox
-# nor the system-call filter is applied here: tools/check-syscalls.sh) with the packaged configuration (a simulated
-# rig) becomes ready and publishes poses over shared memory and UDP, a consumer built with find_package(mcslam)
-# against the installed headers reads them, SIGTERM stops it cleanly; an upgrade keeps a changed configuration and
-# the state; remove keeps both, purge removes them. Also the unit's `systemd-analyze security` exposure.
-# Needs root (chroot, mounts). amd64 only (an arm64 root would run under qemu-user through binfmt_misc).
+# Checks the Debian package the way a robot builder meets it, in a clean Debian 12 root of the package's architecture
+# (made once with mmdebstrap, kept in ~/.cache/mcslam/; unpacked afresh for every check): install with apt (its
+# dependencies from Debian), the files (manual pages included) and the system user in place, mcslamd started as
+# systemd starts it (the unit's ExecStart, as the unit's user, with $STATE_DIRECTORY) with the packaged configuration
+# (a simulated rig) becomes ready and publishes poses over shared memory and UDP, a consumer built with
+# find_package(mcslam) against the installed headers reads them, SIGTERM stops it cleanly. Then the root boots with
+# systemd (systemd-nspawn --boot; skipped with a message where nspawn cannot boot it): `systemctl start` brings the
+# daemon up under the unit's sandbox and system-call filter, poses arrive over both transports, a daemon stopped dead
+# is restarted by the watchdog, `systemctl stop` stops it, and `systemd-analyze security` scores the running unit.
+# Last, an upgrade keeps a changed configuration and the state; remove keeps both, purge removes them.
+# An arm64 package runs in an arm64 root under qemu-user, which this script registers with binfmt_misc when missing.
+# Needs root (chroot, mounts, nspawn).
 #
 # Usage: tools/package-check.sh [DEB]      (default: the newest dist/mcslam_*_amd64.deb; tools/package.sh makes it)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ "$(id -u)" -eq 0 ] || { echo "package-check: needs root (chroot and mounts)" >&2; exit 2; }
-deb="${1:-$(ls -t dist/mcslam_*_amd64.deb 2>/dev/null | head -n 1)}"
+deb="${1:-$(ls -t dist/mcslam_*_"$(dpkg --print-architecture)".deb 2>/dev/null | head -n 1)}"
 [ -f "$deb" ] || { echo "package-check: no package (run tools/package.sh first)" >&2; exit 2; }
 deb="$(realpath "$deb")"
 
+arch="$(dpkg-deb -f "$deb" Architecture)"
+
 source tools/install-packages.sh
-install_missing package-check mmdebstrap systemd
+install_missing package-check mmdebstrap systemd systemd-container arch-test
+if [ "$arch" != "$(dpkg --print-architecture)" ]; then
+  install_missing package-check qemu-user-static
+  tools/register-qemu-binfmt.sh "$arch"
+fi
 cache="${HOME}/.cache/mcslam"
-clean="$cache/debian12-amd64-apt.tar"
+clean="$cache/debian12-$arch-apt.tar"
 if [ ! -f "$clean" ]; then
   mkdir -p "$cache"
-  mmdebstrap --variant=apt bookworm "$clean.tmp" "deb http://deb.debian.org/debian bookworm main" \
+  mmdebstrap --arch="$arch" --variant=apt --format=tar bookworm "$clean.tmp" "deb http://deb.debian.org/debian bookworm main" \
     "deb http://deb.debian.org/debian-security bookworm-security main"
   mv "$clean.tmp" "$clean"
 fi
 root="$(mktemp -d /tmp/mcslam-package-check.XXXXXX)"
-trap 'umount -R "$root/proc" "$root/dev" 2>/dev/null || true; rm -rf "$root"' EXIT
+box_pid=""
+daemon_pid=""
+# The root holds the host's /dev (bound): nothing may be deleted while anything is still mounted below it. A check
+# that failed leaves its daemon running (under qemu for arm64), which keeps the mounts busy: it is stopped first,
+# the mounts are detached lazily if need be, and the root's files are deleted on its own file system only.
+cleanup() {
+  [ -n "$box_pid" ] && kill "$box_pid" 2>/dev/null && wait "$box_pid" 2>/dev/null
+  [ -n "$daemon_pid" ] && kill -KILL "$daemon_pid" 2>/dev/null && wait "$daemon_pid" 2>/dev/null
+  local m
+  for m in "$root/dev" "$root/proc"; do
+    mountpoint -q "$m" && { umount -R "$m" 2>/dev/null || umount -R -l "$m"; }
+  done
+  if findmnt -rn -o TARGET | grep -q "^$root/"; then
+    echo "package-check: $root still has mounts below it: left in place (umount -R -l, then delete it)" >&2
+    return
+  fi
+  rm -rf --one-file-system "$root"
+}
+trap cleanup EXIT
 tar -C "$root" -xf "$clean"
 cp /etc/resolv.conf "$root/etc/resolv.conf"
-mount -t proc proc "$root/proc"
-mount --rbind /dev "$root/dev"
+mount_root() {
+  mount -t proc proc "$root/proc"
+  mount --rbind /dev "$root/dev"
+}
+mount_root
 in_root() { chroot "$root" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEND=noninteractive "$@"; }
 step() { echo "package-check: $*"; }
 fail() { echo "package-check: FAILED: $*" >&2; exit 1; }
@@ -65,6 +95,7 @@ stop_daemon() {
   local status=0
   wait "$daemon_pid" || status=$?
   [ "$status" -eq 0 ] || { cat "$root/tmp/mcslamd.log"; fail "mcslamd exited with $status after SIGTERM"; }
+  daemon_pid=""
 }
 
 run_daemon
@@ -87,6 +118,9 @@ grep -q "stopped:" "$root/tmp/mcslamd.log" || fail "no stop summary in the log"
 [ -s "$root/var/lib/mcslamd/trajectory.tum" ] || fail "no trajectory in the state directory"
 step "stopped cleanly; trajectory $(grep -vc '^#' "$root/var/lib/mcslamd/trajectory.tum") poses in /var/lib/mcslamd"
 
+source tools/package-check-systemd.sh
+check_under_systemd
+
 step "upgrade keeps a changed configuration and the state"
 echo "# changed by the robot builder" >>"$root/etc/mcslamd/mcslamd.yaml"
 echo "saved map stand-in" >"$root/var/lib/mcslamd/map.mcmap"
@@ -107,7 +141,9 @@ in_root apt-get remove -y -q mcslam >/dev/null
 in_root apt-get purge -y -q mcslam >/dev/null
 [ ! -e "$root/etc/mcslamd/mcslamd.yaml" ] && [ ! -e "$root/var/lib/mcslamd" ] || fail "purge left the configuration or the state"
 
-step "the unit's sandboxing (systemd-analyze security, offline)"
-dpkg-deb -x "$deb" "$root/unpacked"
-systemd-analyze security --offline=true "$root/unpacked/usr/lib/systemd/system/mcslamd.service" 2>/dev/null | tail -n 1
+if [ -z "${security_score:-}" ]; then
+  step "the unit's sandboxing (systemd-analyze security, offline)"
+  dpkg-deb -x "$deb" "$root/unpacked"
+  systemd-analyze security --offline=true "$root/unpacked/usr/lib/systemd/system/mcslamd.service" 2>/dev/null | tail -n 1
+fi
 echo "package-check: all checks passed"

@@ -104,11 +104,15 @@ enum class ReadStatus { Ok, NotYet, Overwritten, Busy };
 
 // When process `pid` started, in clock ticks after boot (/proc/<pid>/stat, field 22); 0 when it cannot be read.
 // Unlike the pid, which the kernel hands out again, it tells a process from a later one of the same pid. No
-// allocation.
+// allocation. Read relative to /proc's directory: qemu-user rewrites a process's absolute /proc/<own pid>/stat
+// with a start of its own making, so a writer under it would record a start that its readers never see.
 inline uint64_t processStartTicks(long pid) {
-  char path[48];
-  std::snprintf(path, sizeof(path), "/proc/%ld/stat", pid);
-  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  char path[32];
+  std::snprintf(path, sizeof(path), "%ld/stat", pid);
+  const int proc = ::open("/proc", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (proc < 0) return 0;
+  const int fd = ::openat(proc, path, O_RDONLY | O_CLOEXEC);
+  ::close(proc);
   if (fd < 0) return 0;
   char text[1024];
   const ssize_t n = ::read(fd, text, sizeof(text) - 1);
