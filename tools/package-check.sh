@@ -12,7 +12,8 @@
 # An arm64 package runs in an arm64 root under qemu-user, which this script registers with binfmt_misc when missing.
 # Needs root (chroot, mounts, nspawn).
 #
-# Usage: tools/package-check.sh [DEB]      (default: the newest dist/mcslam_*_amd64.deb; tools/package.sh makes it)
+# Usage: tools/package-check.sh [DEB]      (default: the newest dist/mcslam_*_<this machine's arch>.deb;
+#                                          tools/package.sh makes it)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ "$(id -u)" -eq 0 ] || { echo "package-check: needs root (chroot and mounts)" >&2; exit 2; }
@@ -42,18 +43,33 @@ daemon_pid=""
 # The root holds the host's /dev (bound): nothing may be deleted while anything is still mounted below it. A check
 # that failed leaves its daemon running (under qemu for arm64), which keeps the mounts busy: it is stopped first,
 # the mounts are detached lazily if need be, and the root's files are deleted on its own file system only.
+stop_box() {  # systemd-nspawn, if running: asked to stop, killed after 30 s
+  [ -n "$box_pid" ] || return 0
+  kill "$box_pid" 2>/dev/null || true
+  local waited=0
+  while kill -0 "$box_pid" 2>/dev/null && [ "$waited" -lt 30 ]; do sleep 1; waited=$((waited + 1)); done
+  kill -KILL "$box_pid" 2>/dev/null || true
+  wait "$box_pid" 2>/dev/null || true
+  box_pid=""
+}
 cleanup() {
-  [ -n "$box_pid" ] && kill "$box_pid" 2>/dev/null && wait "$box_pid" 2>/dev/null
-  [ -n "$daemon_pid" ] && kill -KILL "$daemon_pid" 2>/dev/null && wait "$daemon_pid" 2>/dev/null
-  local m
+  set +e
+  stop_box
+  if [ -n "$daemon_pid" ]; then
+    kill -KILL "$daemon_pid" 2>/dev/null
+    wait "$daemon_pid" 2>/dev/null
+  fi
+  local m mounts
   for m in "$root/dev" "$root/proc"; do
     mountpoint -q "$m" && { umount -R "$m" 2>/dev/null || umount -R -l "$m"; }
   done
-  if findmnt -rn -o TARGET | grep -q "^$root/"; then
+  mounts="$(findmnt -rn -o TARGET)"
+  if awk -v r="$root/" 'index($0, r) == 1 { found = 1 } END { exit !found }' <<<"$mounts"; then
     echo "package-check: $root still has mounts below it: left in place (umount -R -l, then delete it)" >&2
     return
   fi
   rm -rf --one-file-system "$root"
+  rm -f "$root.boot.log"
 }
 trap cleanup EXIT
 tar -C "$root" -xf "$clean"
@@ -139,7 +155,8 @@ in_root apt-get remove -y -q mcslam >/dev/null
 [ ! -e "$root/usr/bin/mcslamd" ] || fail "remove left /usr/bin/mcslamd"
 [ -f "$root/etc/mcslamd/mcslamd.yaml" ] && [ -f "$root/var/lib/mcslamd/map.mcmap" ] || fail "remove lost the configuration or the state"
 in_root apt-get purge -y -q mcslam >/dev/null
-[ ! -e "$root/etc/mcslamd/mcslamd.yaml" ] && [ ! -e "$root/var/lib/mcslamd" ] || fail "purge left the configuration or the state"
+[ ! -e "$root/etc/mcslamd/mcslamd.yaml" ] && [ ! -e "$root/var/lib/mcslamd" ] && [ ! -e "$root/var/lib/private/mcslamd" ] ||
+  fail "purge left the configuration or the state"
 
 if [ -z "${security_score:-}" ]; then
   step "the unit's sandboxing (systemd-analyze security, offline)"

@@ -15,7 +15,10 @@ dir=/proc/sys/fs/binfmt_misc
   { echo "register-qemu-binfmt: cannot mount binfmt_misc at $dir" >&2; exit 1; }
 if [ -e "$dir/$name" ]; then
   grep -q '^enabled' "$dir/$name" && grep -q '^flags:.*F' "$dir/$name" && exit 0
-  echo -1 >"$dir/$name"  # registered without F (the emulator would have to be inside the chroot): replace it
+  # Disabled, or registered without F (the emulator would then have to be inside the chroot): replaced, for the
+  # whole machine until it reboots.
+  echo "register-qemu-binfmt: replacing this machine's $name entry ($(head -n 1 "$dir/$name"), $(grep '^flags' "$dir/$name"))"
+  echo -1 >"$dir/$name"
 fi
 emulator=/usr/bin/qemu-aarch64-static
 [ -x "$emulator" ] || { echo "register-qemu-binfmt: $emulator missing (apt-get install qemu-user-static)" >&2; exit 1; }

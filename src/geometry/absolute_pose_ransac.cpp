@@ -150,9 +150,11 @@ AbsolutePoseRansacResult AbsolutePoseRansac::estimate(std::span<const PoseObserv
       const int refined_inliers = classify(obs, refined.T_w_b);
       if (refined_inliers > num_inliers) {
         best = refined.T_w_b;
+        num_inliers = refined_inliers;  // inliers_ holds its classification
         result.from_prediction = true;
+      } else {
+        num_inliers = classify(obs, best);
       }
-      num_inliers = classify(obs, best);
     }
   }
   result.T_w_b = best;
