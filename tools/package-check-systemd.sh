@@ -23,11 +23,8 @@ boot_root() {  # sets box_pid (systemd-nspawn) and box_init (the root's systemd)
   return 1
 }
 
-power_off_root() {
-  in_box systemctl poweroff >/dev/null 2>&1 || true
-  local waited=0
-  while kill -0 "$box_pid" 2>/dev/null && [ "$waited" -lt 60 ]; do sleep 1; waited=$((waited + 1)); done
-  stop_box
+power_off_root() {  # then the chroot's mounts again, for the steps that follow
+  stop_box 60
   mount_root
 }
 
@@ -40,14 +37,14 @@ check_under_systemd() {
     fail "installing systemd in the root"
   umount -R "$root/proc" "$root/dev" || fail "unmounting the root's /proc and /dev (nspawn mounts its own)"
   if ! boot_root; then
+    cp "$root.boot.log" /tmp/mcslam-package-check-boot.log 2>/dev/null || true  # the cleanup deletes the original
     # MCSLAM_REQUIRE_SYSTEMD=1: a root that does not boot is a failure, not a skip.
-    [ "${MCSLAM_REQUIRE_SYSTEMD:-0}" = 1 ] && fail "the root did not boot under systemd-nspawn (console: $root.boot.log)"
-    cp "$root.boot.log" /tmp/mcslam-package-check-boot.log 2>/dev/null || true
+    [ "${MCSLAM_REQUIRE_SYSTEMD:-0}" = 1 ] &&
+      fail "the root did not boot under systemd-nspawn (console: /tmp/mcslam-package-check-boot.log)"
     echo "package-check: SKIPPED the systemd checks: the root did not boot under systemd-nspawn within" \
       "${boot_timeout_s}s (its console: /tmp/mcslam-package-check-boot.log)"
     tail -n 5 "$root.boot.log" || true
-    stop_box
-    mount_root
+    power_off_root
     return 0
   fi
   step "systemctl start mcslamd (Type=notify: returns once the daemon said READY=1)"

@@ -43,11 +43,11 @@ daemon_pid=""
 # The root holds the host's /dev (bound): nothing may be deleted while anything is still mounted below it. A check
 # that failed leaves its daemon running (under qemu for arm64), which keeps the mounts busy: it is stopped first,
 # the mounts are detached lazily if need be, and the root's files are deleted on its own file system only.
-stop_box() {  # systemd-nspawn, if running: asked to stop, killed after 30 s
+stop_box() {  # systemd-nspawn, if running: SIGTERM shuts the root down in order; killed after $1 s (30)
   [ -n "$box_pid" ] || return 0
   kill "$box_pid" 2>/dev/null || true
   local waited=0
-  while kill -0 "$box_pid" 2>/dev/null && [ "$waited" -lt 30 ]; do sleep 1; waited=$((waited + 1)); done
+  while kill -0 "$box_pid" 2>/dev/null && [ "$waited" -lt "${1:-30}" ]; do sleep 1; waited=$((waited + 1)); done
   kill -KILL "$box_pid" 2>/dev/null || true
   wait "$box_pid" 2>/dev/null || true
   box_pid=""
