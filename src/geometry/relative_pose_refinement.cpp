@@ -54,24 +54,6 @@ SE3 applyStep(const SE3& T, const VecUpTo6& step, bool fixed_scale, const Eigen:
   return out;
 }
 
-// Derivative of the normalized error including its normalization (central differences): away
-// from the optimum the frozen-normalization Jacobian is not a descent direction and LM stalls.
-double fullJacobian(const RayPair& m, const SE3& T, Row6& J) {
-  constexpr double h = 1e-7;
-  for (int k = 0; k < 6; ++k) {
-    SE3 Tp = T, Tm = T;
-    if (k < 3) {
-      Tp.t[k] += h;
-      Tm.t[k] -= h;
-    } else {
-      Tp.R = T.R * so3Exp(Vec3::Unit(k - 3) * h);
-      Tm.R = T.R * so3Exp(-Vec3::Unit(k - 3) * h);
-    }
-    J(k) = (sampsonError(m, Tp) - sampsonError(m, Tm)) / (2 * h);
-  }
-  return sampsonError(m, T);
-}
-
 // The match with its bearings moved (first order, to convergence) onto the model T: the Jacobian
 // for the information matrix must not contain the measurement noise, or the noise itself looks
 // like information about weakly observed directions (the metric scale above all).
@@ -111,8 +93,10 @@ class RelativePoseProblem final : public backend::LeastSquaresProblem {
     g_ = VecUpTo6::Zero(dim_);
     for (size_t i = 0; i < matches_.size(); ++i) {
       if (!mask_[i]) continue;
+      // The whole derivative: away from the optimum the one with the normalization held is not a descent
+      // direction and LM stalls.
       Row6 J6;
-      const double e = fullJacobian(matches_[i], T_, J6);
+      const double e = sampsonError(matches_[i], T_, nullptr, &J6);
       RowUpTo6 J(dim_);
       if (central_) {
         J << J6.leftCols<3>() * B_, J6.rightCols<3>();
@@ -159,7 +143,8 @@ class RelativePoseProblem final : public backend::LeastSquaresProblem {
 
 }  // namespace
 
-double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J) {
+double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J,
+                    Eigen::Matrix<double, 1, 6>* J_full) {
   const Mat3& R = T_1_2.R;
   const Vec3& t = T_1_2.t;
   const Vec3 m1 = m.c1.cross(m.d1);
@@ -172,13 +157,31 @@ double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1,
   // plane where bearing noise lives.
   const Vec3 g1 = Rm2 + t.cross(Rd2) + Rd2.cross(m.c1);
   const Vec3 Rt_d1 = R.transpose() * m.d1;
-  const Vec3 g2 = Rt_d1.cross(m.c2) + R.transpose() * (m.d1.cross(t)) + R.transpose() * m1;
-  const double s2 = (g1 - g1.dot(m.d1) * m.d1).squaredNorm() + (g2 - g2.dot(m.d2) * m.d2).squaredNorm();
+  const Vec3 Rt_d1_x_t = R.transpose() * (m.d1.cross(t));
+  const Vec3 Rt_m1 = R.transpose() * m1;
+  const Vec3 g2 = Rt_d1.cross(m.c2) + Rt_d1_x_t + Rt_m1;
+  const Vec3 h1 = g1 - g1.dot(m.d1) * m.d1, h2 = g2 - g2.dot(m.d2) * m.d2;
+  const double s2 = h1.squaredNorm() + h2.squaredNorm();
   const double s = std::sqrt(std::max(s2, 1e-24));
-  if (J) {
-    J->leftCols<3>() = Rd2.cross(m.d1).transpose() / s;
-    const Vec3 dphi = (R.transpose() * m.d1.cross(t)).cross(m.d2) + Rt_d1.cross(m2) + (R.transpose() * m1).cross(m.d2);
-    J->rightCols<3>() = -dphi.transpose() / s;
+  if (!J && !J_full) return e / s;
+  Eigen::Matrix<double, 1, 6> de;
+  de.leftCols<3>() = Rd2.cross(m.d1).transpose();
+  const Vec3 dphi = Rt_d1_x_t.cross(m.d2) + Rt_d1.cross(m2) + Rt_m1.cross(m.d2);
+  de.rightCols<3>() = -dphi.transpose();
+  if (J) *J = de / s;
+  if (J_full) {
+    // d(e / s) = de / s - e ds / s^2, with s ds = h1 . dg1 + h2 . dg2 (h = the projected g), for t + dt and
+    // R exp(phi): R v moves by R (phi x v), R^T v by (R^T v) x phi.
+    Eigen::Matrix<double, 1, 6> s_ds = Eigen::Matrix<double, 1, 6>::Zero();
+    if (s2 > 1e-24) {
+      s_ds.leftCols<3>() = (Rd2.cross(h1) + (R * h2).cross(m.d1)).transpose();
+      const Vec3 Rt_h1 = R.transpose() * h1;
+      s_ds.rightCols<3>() =
+          (m2.cross(Rt_h1) + m.d2.cross(R.transpose() * (h1.cross(t))) + m.d2.cross(R.transpose() * m.c1.cross(h1)) +
+           m.c2.cross(h2).cross(Rt_d1) + h2.cross(Rt_d1_x_t + Rt_m1))
+              .transpose();
+    }
+    *J_full = de / s - (e / (s * s * s)) * s_ds;
   }
   return e / s;
 }

@@ -16,8 +16,10 @@ struct RayPair {
 
 // Generalized epipolar error of a match under T_1_2 = (R, t), divided by its first-order standard
 // deviation per unit bearing noise (a Sampson error, radians). With J: its derivative with respect
-// to [dt; phi] for t + dt, R * exp(phi) (the normalization held fixed).
-double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J = nullptr);
+// to [dt; phi] for t + dt, R * exp(phi) with the normalization held fixed; with J_full: the whole derivative, the
+// normalization's included (away from the solution the held one is not a descent direction).
+double sampsonError(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J = nullptr,
+                    Eigen::Matrix<double, 1, 6>* J_full = nullptr);
 
 // Levenberg-Marquardt with Huber loss over the matches with mask != 0. fixed_scale: |t| keeps its
 // starting value (central poses, and the first stage of generalized ones: where the scale is weak
