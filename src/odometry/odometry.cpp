@@ -45,7 +45,9 @@ Rig Odometry::refinedRig() const { return bridge_->refinedRig(); }
 
 const RigState& Odometry::rigState() const { return bridge_->rigState(); }
 
-uint64_t Odometry::backendThreadAllocations() const { return bridge_->backendThreadAllocations(); }
+uint64_t Odometry::backendThreadAllocations() const {
+  return bridge_->backendThreadAllocations() + scale_->threadAllocations();
+}
 
 void Odometry::resetMap() {
   pending_keyframe_ = -1;  // its window goes with the map
@@ -224,15 +226,16 @@ void Odometry::finishKeyframe(int slot) {
 }
 
 void Odometry::estimateScale() {
-  const ScaleSupervisor::Rescale r =
-      scale_->onKeyframe(map_, bridge_->rigState(), tracker_->rotationTravelled(), frame_index_, stats_);
-  if (!r.apply) return;
-  // The whole live map, the window and the motion model take the new unit at once.
-  bridge_->rescale(map_, r.s, r.center);
-  tracker_->rescale(r.s, r.center);
-  if (rescale_count_ < static_cast<int>(rescales_.size()))
-    rescales_[static_cast<std::size_t>(rescale_count_++)] = {r.s, r.center};
-  if (r.converged) bridge_->setScaleStatus(ScaleStatus::Metric);
+  const ScaleSupervisor::Rescale r = scale_->takeEstimate(map_, bridge_->rigState(), frame_index_, stats_);
+  if (r.apply) {
+    // The whole live map, the window and the motion model take the new unit at once.
+    bridge_->rescale(map_, r.s, r.center);
+    tracker_->rescale(r.s, r.center);
+    if (rescale_count_ < static_cast<int>(rescales_.size()))
+      rescales_[static_cast<std::size_t>(rescale_count_++)] = {r.s, r.center};
+    if (r.converged) bridge_->setScaleStatus(ScaleStatus::Metric);
+  }
+  scale_->startEstimate(map_, bridge_->rigState(), tracker_->rotationTravelled(), frame_index_);
 }
 
 void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {

@@ -260,6 +260,7 @@ bool ScaleEstimator::selectWindow(const Map& map, ScaleEstimate& out) {
   out.center = map.keyframe(oldest).T_w_b.t;
   oldest_ = kf_slot_of_[oldest];
   out.oldest_id = map.keyframe(oldest).id;
+  out.oldest_slot = oldest;
   out.newest_id = map.keyframe(newest).id;
   for (int w = 0; w < nk_; ++w) {
     kf_T_[w] = map.keyframe(kf_order_[w]).T_w_b;
@@ -268,25 +269,44 @@ bool ScaleEstimator::selectWindow(const Map& map, ScaleEstimate& out) {
   return true;
 }
 
+int ScaleEstimator::windowViews(const Landmark& L) const {
+  uint32_t seen_by = 0;  // bit per window keyframe
+  for (int j = 0; j < L.obs_count; ++j) {
+    const int w = kf_slot_of_[L.obs[j].keyframe];
+    if (w >= 0) seen_by |= 1u << w;
+  }
+  return std::popcount(seen_by);
+}
+
 // Landmarks seen from at least three window keyframes, with their window observations. A landmark of two
 // keyframes was created by an epipolar search at the map's poses: its two rays were chosen because they meet
 // there, so it agrees with the map's unit whether or not it is a lookalike. A third keyframe's observation is a
-// test it could fail.
+// test it could fail. The profile's share comes first: every stride-th of them, an even sample (not those seen
+// most: the far ones, which say least about the scale).
 void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
+  int eligible = 0;
+  for (int lm = 0; lm < map.landmarkCapacity(); ++lm) {
+    const Landmark& L = map.landmark(lm);
+    if (L.alive && windowViews(L) >= kMinLandmarkKeyframes) ++eligible;
+  }
+  const int stride = std::max(1, (eligible + kProfileLandmarks - 1) / kProfileLandmarks);
   nl_ = 0;
   no_ = 0;
+  appendLandmarks(map, center, stride, true);
+  np_ = nl_;
+  if (stride > 1) appendLandmarks(map, center, stride, false);
+  lm_first_[nl_] = no_;
+}
+
+void ScaleEstimator::appendLandmarks(const Map& map, const Vec3& center, int stride, bool profile_share) {
+  int eligible = 0;
   for (int lm = 0; lm < map.landmarkCapacity() && nl_ < static_cast<int>(lm_p_.size()); ++lm) {
     const Landmark& L = map.landmark(lm);
-    if (!L.alive) continue;
+    if (!L.alive || windowViews(L) < kMinLandmarkKeyframes) continue;
+    if ((eligible++ % stride == 0) != profile_share) continue;
     int n = 0;
-    uint32_t seen_by = 0;  // bit per window keyframe
-    for (int j = 0; j < L.obs_count; ++j) {
-      const int w = kf_slot_of_[L.obs[j].keyframe];
-      if (w < 0) continue;
-      ++n;
-      seen_by |= 1u << w;
-    }
-    if (std::popcount(seen_by) < kMinLandmarkKeyframes || no_ + n > static_cast<int>(obs_.size())) continue;
+    for (int j = 0; j < L.obs_count; ++j) n += kf_slot_of_[L.obs[j].keyframe] >= 0 ? 1 : 0;
+    if (no_ + n > static_cast<int>(obs_.size())) continue;
     lm_first_[nl_] = no_;
     for (int j = 0; j < L.obs_count; ++j) {
       const int w = kf_slot_of_[L.obs[j].keyframe];
@@ -298,7 +318,6 @@ void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
     lm_p_[nl_] = L.p_w - center;
     ++nl_;
   }
-  lm_first_[nl_] = no_;
 }
 
 // The profile of the cost over log s in [-log max_ratio, log max_ratio], from the map's unit outwards both ways;
@@ -332,34 +351,52 @@ bool ScaleEstimator::profileScale(double max_ratio) {
   return true;
 }
 
-ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
-  ScaleEstimate out;
-  if (!selectWindow(map, out)) return out;
+bool ScaleEstimator::prepare(const Map& map, ScaleEstimate& out) {
+  out = ScaleEstimate{};
+  if (!selectWindow(map, out)) return false;
   collectLandmarks(map, out.center);
   out.landmarks = nl_;
   out.observations = no_;
-  if (nl_ < 20) return out;
-  const double scale_before = scaleOfPoses();
-  if (!(scale_before > 0)) return out;
+  return nl_ >= 20;
+}
 
-  // 1. Coarse (max_ratio > 1): the profile brings a map whose unit is far off into the basin.
-  if (max_ratio > 1.0 && !profileScale(max_ratio)) return out;
+void ScaleEstimator::solve(double max_ratio, ScaleEstimate& out) {
+  const double scale_before = scaleOfPoses();
+  if (!(scale_before > 0)) return;
+
+  // 1. Coarse (max_ratio > 1): the profile brings a map whose unit is far off into the basin. It only chooses the
+  //    basin: a sample of the landmarks is enough for that (it re-fits the window at every factor it tries), and
+  //    the others then take the factor it chose.
+  if (max_ratio > 1.0) {
+    const int all = nl_;
+    nl_ = np_;
+    const bool found = profileScale(max_ratio);
+    const double factor = scaleOfPoses() / scale_before;
+    nl_ = all;
+    if (!found) return;
+    for (int l = np_; l < nl_; ++l) lm_p_[l] *= factor;
+  }
 
   // 2. Fine: Levenberg-Marquardt on the whole window, the scale free; the last system gives the marginal sigma.
   double c = 0, last_u_step = 0, chi2 = 0;
   int residuals = 0;
-  if (!refine(kRefineSteps, c, last_u_step) || !reducedSystem(chi2, residuals)) return out;
+  if (!refine(kRefineSteps, c, last_u_step) || !reducedSystem(chi2, residuals)) return;
   // A refinement that still moved the scale by more than its sigma has not found the window's minimum: its
   // curvature says nothing about the scale.
-  if (!(last_u_step * last_u_step <= scale_variance_)) return out;
+  if (!(last_u_step * last_u_step <= scale_variance_)) return;
   const double dof = std::max(1.0, 2.0 * residuals - 3.0 * nl_ - 6.0 * (nk_ - 1));
   out.reduced_chi2 = chi2 / dof;
   const double reduced = std::max(1.0, out.reduced_chi2);
   const double variance = scale_variance_ * reduced;
-  if (!(variance > 0)) return out;
+  if (!(variance > 0)) return;
   out.scale = scaleOfPoses() / scale_before;
   out.relative_sigma = std::sqrt(variance);
   out.ok = std::isfinite(out.scale) && out.scale > 0;
+}
+
+ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
+  ScaleEstimate out;
+  if (prepare(map, out)) solve(max_ratio, out);
   return out;
 }
 

@@ -13,15 +13,28 @@ namespace mcslam {
 namespace {
 
 // The lever arms tell the scale only while the window turns: a window that turned less than this is not searched
-// (its estimate would come back with a useless sigma after costing the tracking thread most of a frame, at every
-// keyframe of a rig whose scale never converges).
+// (its estimate would come back with a useless sigma after costing most of a frame's CPU, at every keyframe of a
+// rig whose scale never converges).
 constexpr double kMinWindowTurnRad = 2.0 * M_PI / 180.0;
-// The search range: the whole of OdometryOptions::scale_search_ratio while the unit is arbitrary; within a factor
-// kKnownRatio once the combined windows know it to kKnownSigma or it has converged (the search re-fits the window
-// at every factor it tries: the range is most of its cost).
-constexpr double kKnownSigma = 0.2, kKnownRatio = 2.0;
+// The profile search over the whole of OdometryOptions::scale_search_ratio runs while the unit is arbitrary. Once
+// the combined windows know it to kKnownSigma, or it has converged, the refinement starts from the map's unit: the
+// profile re-fits the window at every factor it tries, most of an estimate's cost (BENCHMARKS.md section 7 for
+// what that changes).
+constexpr double kKnownSigma = 0.2;
 
 }  // namespace
+
+struct ScaleSupervisor::EstimateJob final : BackgroundJob {
+  void run() override {
+    if (prepared) estimator->solve(ratio, result);
+  }
+  ScaleEstimator* estimator = nullptr;
+  bool prepared = false;
+  double ratio = 1;
+  ScaleEstimate result;
+  double rotation_travelled = 0;  // the rig's, at the copy
+  uint64_t frame_index = 0;       // of the keyframe copied
+};
 
 ScaleSupervisor::ScaleSupervisor(const Rig& rig, const OdometryOptions& options, int max_features_per_camera)
     : options_(options) {
@@ -32,12 +45,25 @@ ScaleSupervisor::ScaleSupervisor(const Rig& rig, const OdometryOptions& options,
   estimator_ = std::make_unique<ScaleEstimator>(rig, std::min(options.max_landmarks, window_obs), window_obs,
                                                 options.max_keyframes, options.scale_factor, options.levels);
   filter_ = std::make_unique<ScaleFilter>();
+  job_ = std::make_unique<EstimateJob>();
+  job_->estimator = estimator_.get();
+  if (options.backend_thread) task_ = std::make_unique<BackgroundTask>();
 }
 
-ScaleSupervisor::~ScaleSupervisor() = default;
+ScaleSupervisor::~ScaleSupervisor() {
+  if (task_) task_->wait();  // the estimator must outlive an estimate in flight
+}
+
+void ScaleSupervisor::endEstimate() {
+  if (task_) task_->collect();
+  in_flight_ = false;
+}
 
 void ScaleSupervisor::start(bool unscaled) {
   unscaled_start_ = unscaled;
+  // An estimate in flight belonged to the old map: taken at the next settled keyframe and dropped, so that a new
+  // map does not wait for it.
+  stale_ = in_flight_;
   if (filter_) filter_->reset();
 }
 
@@ -52,26 +78,49 @@ double ScaleSupervisor::windowTurn(const Map& map) {
   return turn;
 }
 
-ScaleSupervisor::Rescale ScaleSupervisor::onKeyframe(const Map& map, const RigState& rig, double rotation_travelled,
-                                                     uint64_t frame_index, OdometryStats& stats) {
-  Rescale r;
-  // At every keyframe, before convergence and after it: the unit drifts between turns, and the profile search
-  // finds what a refinement from the map as it is would not (the map's own unit looks best to it).
-  if (!unscaled_start_ || !estimator_) return r;
-  if (windowTurn(map) < kMinWindowTurnRad) return r;
+void ScaleSupervisor::startEstimate(const Map& map, const RigState& rig, double rotation_travelled,
+                                    uint64_t frame_index) {
+  // At every keyframe, before convergence and after it: the unit drifts between turns.
+  if (!unscaled_start_ || !estimator_ || in_flight_) return;
+  if (windowTurn(map) < kMinWindowTurnRad) return;
   const bool scale_converged = rig.scaleConverged();
-  const double ratio = scale_converged || filter_->sigma() <= kKnownSigma
-                           ? std::min(kKnownRatio, options_.scale_search_ratio)
-                           : options_.scale_search_ratio;
+  job_->ratio = scale_converged || filter_->sigma() <= kKnownSigma ? 1.0 : options_.scale_search_ratio;
+  job_->rotation_travelled = rotation_travelled;
+  job_->frame_index = frame_index;
   estimator_->follow(rig);
-  const ScaleEstimate e = estimator_->estimate(map, ratio);
+  job_->prepared = estimator_->prepare(map, job_->result);
+  in_flight_ = true;
+  if (task_) {
+    task_->start(*job_);
+  } else {
+    job_->run();
+  }
+}
+
+Vec3 ScaleSupervisor::centerNow(const Map& map, const ScaleEstimate& e) {
+  if (e.oldest_slot < 0 || e.oldest_slot >= map.keyframeCapacity()) return e.center;
+  const Keyframe& k = map.keyframe(e.oldest_slot);
+  return k.alive && k.id == e.oldest_id ? k.T_w_b.t : e.center;
+}
+
+ScaleSupervisor::Rescale ScaleSupervisor::takeEstimate(const Map& map, const RigState& rig, uint64_t frame_index,
+                                                       OdometryStats& stats) {
+  Rescale r;
+  if (!in_flight_) return r;
+  endEstimate();  // waits for it: what follows depends on the estimate, never on the thread's timing
+  if (stale_) {
+    stale_ = false;
+    return r;
+  }
+  const ScaleEstimate& e = job_->result;
+  const uint64_t window_frame = job_->frame_index;
   ++stats.scale_estimates;
   if (!e.ok) return r;
   stats.last_scale = e.scale;
   stats.last_scale_sigma = e.relative_sigma;
-  if (!filter_->add(std::log(e.scale), e.relative_sigma, e.oldest_id, e.newest_id, rotation_travelled)) {
-    spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} dropped as an outlier", frame_index, e.scale,
-                  e.relative_sigma);
+  if (!filter_->add(std::log(e.scale), e.relative_sigma, e.oldest_id, e.newest_id, job_->rotation_travelled)) {
+    spdlog::debug("odometry: scale at frame {}: window {:.4f} sigma {:.4f} dropped as an outlier", window_frame,
+                  e.scale, e.relative_sigma);
     return r;
   }
   const double x = filter_->correction(), sigma = filter_->sigma();
@@ -80,11 +129,12 @@ ScaleSupervisor::Rescale ScaleSupervisor::onKeyframe(const Map& map, const RigSt
   spdlog::debug(
       "odometry: scale at frame {}: window {:.4f} sigma {:.4f} ({} keyframes, {} landmarks, chi2/dof "
       "{:.2f}), combined {:.4f} sigma {:.4f} over {:.0f} deg",
-      frame_index, e.scale, e.relative_sigma, e.keyframes, e.landmarks, e.reduced_chi2, std::exp(x), sigma,
+      window_frame, e.scale, e.relative_sigma, e.keyframes, e.landmarks, e.reduced_chi2, std::exp(x), sigma,
       filter_->rotationSpan() * 180.0 / M_PI);
   // A correction 3 sigma away from 1 is applied at any time: before convergence it brings the arbitrary unit near
   // the metric one (the windows' fits then start in the basin; far off, most windows give no estimate), the poses
   // staying flagged unscaled until the combined sigma reaches the bound.
+  const bool scale_converged = rig.scaleConverged();
   const bool converges = !scale_converged && sigma <= options_.scale_max_sigma &&
                          filter_->rotationSpan() >= options_.scale_min_rotation_deg * M_PI / 180.0;
   // Once converged the map follows the combined estimate as the unit drifts, whenever it is 2 sigma off.
@@ -92,7 +142,7 @@ ScaleSupervisor::Rescale ScaleSupervisor::onKeyframe(const Map& map, const RigSt
   if (!converges && !(std::abs(x) > significant * sigma)) return r;
   r.apply = true;
   r.s = std::exp(x);
-  r.center = e.center;
+  r.center = centerNow(map, e);
   r.converged = converges;
   spdlog::debug("odometry: map rescaled by {:.4f} at frame {}", r.s, frame_index);
   filter_->applied();

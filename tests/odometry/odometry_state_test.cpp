@@ -159,7 +159,9 @@ TEST(ScaleSupervisor, AMetricMapIsNeverRescaled) {
   ScaleSupervisor supervisor(rig, options, 100);
   supervisor.start(false);
   OdometryStats stats;
-  const ScaleSupervisor::Rescale r = supervisor.onKeyframe(map, RigState(rig), 10.0, 7, stats);
+  const RigState state(rig);
+  supervisor.startEstimate(map, state, 10.0, 7);
+  const ScaleSupervisor::Rescale r = supervisor.takeEstimate(map, state, 9, stats);
   EXPECT_FALSE(r.apply);
   EXPECT_EQ(stats.scale_estimates, 0u);
 }

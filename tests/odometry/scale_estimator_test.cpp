@@ -6,7 +6,9 @@
 #include "alloc_testing.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/odometry/odometry.hpp"
 #include "mcslam/odometry/scale_estimator.hpp"
+#include "mcslam/odometry/scale_supervisor.hpp"
 #include "synthetic_sequence.hpp"
 #include "test_support.hpp"
 
@@ -113,6 +115,53 @@ TEST(ScaleEstimator, EstimatesAllocateNothing) {
   EXPECT_TRUE(full.ok);
   EXPECT_EQ(full.keyframes, 8);
   EXPECT_EQ(smaller.keyframes, 5);
+}
+
+// An estimate is copied out of the map at one settled keyframe and taken at the next, with the same result whether
+// it ran on the supervisor's thread or at once, and whatever the map did in between (tracking goes on).
+TEST(ScaleSupervisor, AnEstimateStartedAtOneKeyframeIsTakenAtTheNextWhereverItRan) {
+  const Rig rig = test::nonOverlappingRig3();
+  RigState state(rig);
+  state.setScale(ScaleStatus::Unscaled);
+  ScaleSupervisor::Rescale taken[2];
+  for (const bool thread : {false, true}) {
+    Map map(rig, 2000, 14, 4000);
+    buildWindow(rig, map, 60.0, 2.5, 0.5);
+    OdometryOptions options;
+    options.backend_thread = thread;
+    ScaleSupervisor supervisor(rig, options, 2000);
+    supervisor.start(true);
+    OdometryStats stats;
+    EXPECT_FALSE(supervisor.takeEstimate(map, state, 10, stats).apply);  // none was started
+    supervisor.startEstimate(map, state, 1.0, 10);
+    const int newest = map.newestKeyframe();
+    map.keyframe(newest).T_w_b.t += Vec3(3.0, 0, 0);  // the copy is what counts
+    ScaleSupervisor::Rescale& r = taken[thread ? 1 : 0];
+    r = supervisor.takeEstimate(map, state, 13, stats);
+    EXPECT_EQ(stats.scale_estimates, 1u);
+    ASSERT_TRUE(r.apply) << "thread " << thread;
+    EXPECT_NEAR(r.s * 2.5, 1.0, 0.05);
+    EXPECT_FALSE(supervisor.takeEstimate(map, state, 16, stats).apply);  // taken once
+    EXPECT_EQ(stats.scale_estimates, 1u);
+  }
+  EXPECT_EQ(taken[0].s, taken[1].s);
+  EXPECT_EQ(taken[0].center, taken[1].center);
+}
+
+// A new map drops the estimate in flight: its window belonged to the old one.
+TEST(ScaleSupervisor, ANewMapDropsTheEstimateInFlight) {
+  const Rig rig = test::nonOverlappingRig3();
+  RigState state(rig);
+  state.setScale(ScaleStatus::Unscaled);
+  Map map(rig, 2000, 14, 4000);
+  buildWindow(rig, map, 60.0, 2.5, 0.5);
+  ScaleSupervisor supervisor(rig, OdometryOptions{}, 2000);
+  supervisor.start(true);
+  OdometryStats stats;
+  supervisor.startEstimate(map, state, 1.0, 10);
+  supervisor.start(true);
+  EXPECT_FALSE(supervisor.takeEstimate(map, state, 13, stats).apply);
+  EXPECT_EQ(stats.scale_estimates, 0u);
 }
 
 // The filter says over how much rotation its estimates were gathered, from the first one it kept since it

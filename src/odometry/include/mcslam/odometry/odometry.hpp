@@ -103,7 +103,7 @@ class Odometry {
   // False while a map started up to scale (rig without overlap) waits for its window to fix the scale: poses
   // until then have an arbitrary unit. True for a metric start and for one camera (whose scale never is).
   bool scaleConverged() const { return rigState().scaleConverged(); }
-  // Heap allocations made on the back-end thread so far (0 when the solve runs inline).
+  // Heap allocations made so far on the back-end thread and the scale estimate's (0 when they run inline).
   uint64_t backendThreadAllocations() const;
   // Frame index of the reference frame of the last initialization when it used two frames (the frames
   // between the two have no estimate of their own), -1 when it used one frame.

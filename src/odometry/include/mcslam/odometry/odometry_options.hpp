@@ -78,7 +78,8 @@ struct OdometryOptions {
   int backend_iterations = 6;
   // The solve runs on a thread of its own while tracking goes on with the next frames; its result is applied at a
   // fixed frame, so the output does not depend on timing. A keyframe's own pose is then the tracked one (the
-  // optimized pose is what the following frames continue from).
+  // optimized pose is what the following frames continue from). The scale estimate of a map started up to scale
+  // runs on a thread of its own with it, taken at the next settled keyframe.
   bool backend_thread = true;
   // The frame, counted from the keyframe, before which its solve is applied (1: the next one), for maps that start
   // metric (cameras that overlap). Later spreads the solve over more frame periods instead of stalling one frame

@@ -9,7 +9,8 @@
 //     oldest) and the landmarks are multiplied by it and the window is re-fitted with u held there. Scaling
 //     alone, poses otherwise held, favours the map's own unit: tracking and the back-end fitted the poses in
 //     that unit, absorbing what the lever arms disagree with, so every other unit costs more until the poses
-//     are re-fitted. The profile brings a map whose unit is far off into the basin;
+//     are re-fitted. The profile brings a map whose unit is far off into the basin; it only chooses the basin,
+//     so it fits an even sample of the landmarks (kProfileLandmarks);
 //  2. fine: Levenberg-Marquardt on the whole window (poses and landmarks, landmarks eliminated by the Schur
 //     complement) from there, only steps that lower the cost taken (undamped Gauss-Newton can jump into a
 //     state that looks certain and is far off). The scale is u = log of the summed keyframe
@@ -35,6 +36,7 @@ struct ScaleEstimate {
   double scale = 1;                  // multiply positions about `center` by this
   double relative_sigma = INFINITY;  // sigma(s) / s
   Vec3 center = Vec3::Zero();        // position of the window's oldest keyframe
+  int oldest_slot = -1;              // its map slot
   int keyframes = 0;
   int64_t oldest_id = -1, newest_id = -1;  // the window's keyframe ids
   int landmarks = 0;
@@ -47,18 +49,25 @@ struct ScaleEstimate {
 class ScaleEstimator {
  public:
   // max_observations: observations of window landmarks by window keyframes (window * cameras * features);
-  // max_keyframes: the map's keyframe capacity. All scratch is allocated here: estimate() allocates nothing.
+  // max_keyframes: the map's keyframe capacity. All scratch is allocated here: no estimate allocates.
   ScaleEstimator(const Rig& rig, int max_landmarks, int max_observations, int max_keyframes, float octave_scale_factor,
                  int levels);
-  // Takes the current extrinsics by value (estimate() uses them); allocates nothing.
+  // Takes the current extrinsics by value (the next estimate uses them); allocates nothing.
   void follow(const RigState& state) { rig_ = state.rig(); }
 
   // Uses the map's newest live keyframes (up to kMaxKeyframes) and the landmarks that kMinLandmarkKeyframes of
   // them observe. `max_ratio` bounds the coarse search: s in [1 / max_ratio, max_ratio]; at most 1, the
   // refinement starts from the map as it is.
   ScaleEstimate estimate(const Map& map, double max_ratio);
+  // estimate() in two halves, so that the second can run on another thread while the map changes. prepare()
+  // copies the window out of the map (false: too few keyframes or landmarks, `out` says how many); solve() works
+  // on the copy only and completes `out`.
+  bool prepare(const Map& map, ScaleEstimate& out);
+  void solve(double max_ratio, ScaleEstimate& out);
   static constexpr int kMaxKeyframes = 16;
   static constexpr int kMinLandmarkKeyframes = 3;
+  // The profile's landmarks: an even sample of the window's, at most this many.
+  static constexpr int kProfileLandmarks = 400;
 
  private:
   static constexpr int kMaxDim = 6 * (kMaxKeyframes - 1);
@@ -72,8 +81,12 @@ class ScaleEstimator {
   };
   class Problem;                                              // the Levenberg-Marquardt problem of refine()
   bool selectWindow(const Map& map, ScaleEstimate& out);      // keyframes: kf_T_, oldest_, out's window fields
-  void collectLandmarks(const Map& map, const Vec3& center);  // lm_p_, lm_first_, obs_
-  bool profileScale(double max_ratio);                        // the coarse search
+  void collectLandmarks(const Map& map, const Vec3& center);  // lm_p_, lm_first_, obs_, np_
+  // Appends the landmarks the window can use, with their window observations: every stride-th of them (the
+  // profile's share), or the others.
+  void appendLandmarks(const Map& map, const Vec3& center, int stride, bool profile_share);
+  int windowViews(const Landmark& L) const;  // window keyframes that observe L
+  bool profileScale(double max_ratio);       // the coarse search
   double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
   // Robust cost of landmark l at p, keyframes at kf_T_; p is refined first (two Gauss-Newton steps).
   double landmarkCost(int l, Vec3& p);
@@ -95,10 +108,10 @@ class ScaleEstimator {
   Rig rig_;  // a copy: follow() moves its extrinsics
   backend::RobustLoss loss_;
   std::vector<double> octave_sigma_;
-  std::vector<SE3> T_c_b_;      // per camera, from the rig at the start of estimate() (its extrinsics may follow
-                                // the back-end's)
-  std::vector<SE3> kf_T_;       // per window keyframe: T_w_b, translation relative to the centre
-  std::vector<SE3> kf_before_;  // kf_T_ before a refinement step
+  std::vector<SE3> T_c_b_;               // per camera, from the rig at prepare() (its extrinsics may follow
+                                         // the back-end's)
+  std::vector<SE3> kf_T_;                // per window keyframe: T_w_b, translation relative to the centre
+  std::vector<SE3> kf_before_;           // kf_T_ before a refinement step
   std::vector<SE3> kf_start_, kf_best_;  // the window as the map has it, and the profile's best fit
   std::vector<Vec3> lm_start_, lm_best_;
   int oldest_ = 0;                   // window index of the oldest keyframe (held)
@@ -114,6 +127,7 @@ class ScaleEstimator {
   std::vector<int> lm_first_;    // per landmark: first observation (lm_first_[l + 1] ends it)
   std::vector<Obs> obs_;
   int nk_ = 0, nl_ = 0, no_ = 0;
+  int np_ = 0;  // the first np_ landmarks are the profile's
 };
 
 // The window estimates, combined into the map's log-scale error. Windows that share keyframes are not

@@ -3,10 +3,14 @@
 // back-end window turned, the window's metric scale is estimated (ScaleEstimator), the estimates are combined
 // (ScaleFilter), and the supervisor says when the map must take a new unit: when the combined estimate is certain
 // enough over enough rotation (the scale has converged) or significantly off. The caller applies the rescale to
-// the map, the window and the motion model. Owns the estimator and the filter; the map and the rig state are
-// handed in for each call. All memory is allocated at construction.
+// the map, the window and the motion model. An estimate costs several frames' tracking: it is copied out of the
+// map at one settled keyframe, solved on the supervisor's thread (OdometryOptions::backend_thread; else at once)
+// and taken at the next, whatever the thread's timing, so runs repeat exactly. Owns the estimator, the filter and
+// the thread; the map and the rig state are handed in for each call. All memory is allocated at construction.
 #include <cstdint>
 #include <memory>
+
+#include "mcslam/core/background_task.hpp"
 
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry_options.hpp"
@@ -15,6 +19,7 @@
 namespace mcslam {
 
 class ScaleEstimator;
+struct ScaleEstimate;
 class ScaleFilter;
 struct OdometryStats;
 
@@ -24,7 +29,8 @@ class ScaleSupervisor {
   ScaleSupervisor(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
   ~ScaleSupervisor();
 
-  // A new map starts, up to scale (`unscaled`) or metric; what the filter knew goes with the old one.
+  // A new map starts, up to scale (`unscaled`) or metric; what the filter knew, and an estimate in flight, go with
+  // the old one (the estimate is dropped when taken, without waiting for it here).
   void start(bool unscaled);
 
   struct Rescale {
@@ -33,19 +39,31 @@ class ScaleSupervisor {
     Vec3 center = Vec3::Zero();
     bool converged = false;  // the first rescale of a certain estimate: the map is metric from now on
   };
-  // After keyframe settling: an estimate over the map's newest keyframes, with the extrinsics of `rig`. Updates the
-  // scale counters of `stats`.
-  Rescale onKeyframe(const Map& map, const RigState& rig, double rotation_travelled, uint64_t frame_index,
-                     OdometryStats& stats);
+  // At each settled keyframe (frame `frame_index`), in this order: takeEstimate() waits for the estimate
+  // startEstimate() began at the last one and combines it (updating the scale counters of `stats`); the caller applies
+  // the rescale it returns; then startEstimate() copies the window of the map's newest keyframes out, with the
+  // extrinsics of `rig`, and starts its estimate when the window turned.
+  Rescale takeEstimate(const Map& map, const RigState& rig, uint64_t frame_index, OdometryStats& stats);
+  void startEstimate(const Map& map, const RigState& rig, double rotation_travelled, uint64_t frame_index);
+  // Heap allocations made on the supervisor's thread so far (0 without one).
+  uint64_t threadAllocations() const { return task_ ? task_->allocations() : 0; }
 
  private:
+  struct EstimateJob;
   // Largest rotation (rad) of a back-end window keyframe from the window's oldest.
   static double windowTurn(const Map& map);
+  void endEstimate();  // waits for the estimate in flight, if any; none is in flight after
+  // Where the estimate's window started now: the back-end may have moved its oldest keyframe since the copy.
+  static Vec3 centerNow(const Map& map, const ScaleEstimate& e);
 
   OdometryOptions options_;
   std::unique_ptr<ScaleEstimator> estimator_;  // null for one camera
   std::unique_ptr<ScaleFilter> filter_;
+  std::unique_ptr<EstimateJob> job_;
   bool unscaled_start_ = false;
+  bool in_flight_ = false;                // started and not taken
+  bool stale_ = false;                    // the estimate in flight belongs to a map before start()
+  std::unique_ptr<BackgroundTask> task_;  // last: stops before the estimator goes; null: estimates run at once
 };
 
 }  // namespace mcslam
