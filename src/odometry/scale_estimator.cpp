@@ -281,8 +281,8 @@ int ScaleEstimator::windowViews(const Landmark& L) const {
 // Landmarks seen from at least three window keyframes, with their window observations. A landmark of two
 // keyframes was created by an epipolar search at the map's poses: its two rays were chosen because they meet
 // there, so it agrees with the map's unit whether or not it is a lookalike. A third keyframe's observation is a
-// test it could fail. The profile's share comes first: every stride-th of them, an even sample (not those seen
-// most: the far ones, which say least about the scale).
+// test it could fail. The profile's share comes first: every stride-th of them, an even sample that keeps the
+// near points, which tell the scale best.
 void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
   int eligible = 0;
   for (int lm = 0; lm < map.landmarkCapacity(); ++lm) {

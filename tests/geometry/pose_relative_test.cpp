@@ -40,6 +40,20 @@ int maskErrors(const TwoFrames& f, const std::vector<uint8_t>& mask) {
   return wrong;
 }
 
+// Derivative of the Sampson error e / s with respect to parameter k of [dt; phi] (t + dt, R exp(phi)), by central
+// differences with step h.
+double numericSampsonDerivative(const relative_pose_detail::RayPair& p, const SE3& T, int k, double h) {
+  SE3 Tp = T, Tm = T;
+  if (k < 3) {
+    Tp.t[k] += h;
+    Tm.t[k] -= h;
+  } else {
+    Tp.R = T.R * so3Exp(Vec3::Unit(k - 3) * h);
+    Tm.R = T.R * so3Exp(-Vec3::Unit(k - 3) * h);
+  }
+  return (relative_pose_detail::sampsonError(p, Tp) - relative_pose_detail::sampsonError(p, Tm)) / (2 * h);
+}
+
 }  // namespace
 
 TEST(RelativePose, SampsonJacobianMatchesNumeric) {
@@ -55,17 +69,7 @@ TEST(RelativePose, SampsonJacobianMatchesNumeric) {
     Eigen::Matrix<double, 1, 6> J;
     relative_pose_detail::sampsonError(p, T, &J);
     for (int k = 0; k < 6; ++k) {
-      const double h = 1e-7;
-      SE3 Tp = T, Tm = T;
-      if (k < 3) {
-        Tp.t[k] += h;
-        Tm.t[k] -= h;
-      } else {
-        Tp.R = T.R * so3Exp(Vec3::Unit(k - 3) * h);
-        Tm.R = T.R * so3Exp(-Vec3::Unit(k - 3) * h);
-      }
-      const double numeric =
-          (relative_pose_detail::sampsonError(p, Tp) - relative_pose_detail::sampsonError(p, Tm)) / (2 * h);
+      const double numeric = numericSampsonDerivative(p, T, k, 1e-7);
       EXPECT_NEAR(numeric, J(k), 1e-5 * std::max(1.0, std::abs(numeric))) << k;
     }
   }
@@ -89,17 +93,7 @@ TEST(RelativePose, SampsonFullJacobianMatchesNumericAwayFromTheSolution) {
       relative_pose_detail::sampsonError(p, T, &J_held, &J);
       double largest = 0;
       for (int k = 0; k < 6; ++k) {
-        const double h = 1e-6;
-        SE3 Tp = T, Tm = T;
-        if (k < 3) {
-          Tp.t[k] += h;
-          Tm.t[k] -= h;
-        } else {
-          Tp.R = T.R * so3Exp(Vec3::Unit(k - 3) * h);
-          Tm.R = T.R * so3Exp(-Vec3::Unit(k - 3) * h);
-        }
-        const double numeric =
-            (relative_pose_detail::sampsonError(p, Tp) - relative_pose_detail::sampsonError(p, Tm)) / (2 * h);
+        const double numeric = numericSampsonDerivative(p, T, k, 1e-6);
         EXPECT_NEAR(numeric, J(k), 1e-6 * std::max(1.0, std::abs(numeric))) << k;
         largest = std::max(largest, std::abs(J(k) - J_held(k)));
       }
