@@ -14,6 +14,8 @@ Initializer::Initializer(const Rig& rig, const OdometryOptions& options, int max
   camera_matches_.reserve(correspondences_.capacity());
   best_camera_.inlier_mask.reserve(correspondences_.capacity());
   best_of_ref_.resize(max_features_per_camera);
+  best_ref_distance_.resize(max_features_per_camera);
+  candidate_of_cur_.resize(max_features_per_camera);
 }
 
 int Initializer::usableMultiView(const FrameFeatures& f, double max_depth_sigma) {
@@ -33,24 +35,18 @@ int Initializer::matchToReference(const FrameFeatures& f) {
     if (!f.present[c] || !reference_.present[c]) continue;
     const FeatureSet& ref = reference_.sets[c];
     const FeatureSet& cur = f.sets[c];
+    // Each distance is computed once: it updates both the current keypoint's best and second best and the
+    // reference keypoint's best (first smallest wins in both directions).
     std::fill(best_of_ref_.begin(), best_of_ref_.begin() + ref.count, -1);
-    // Best current keypoint of every reference keypoint (for the mutual check).
-    for (int r = 0; r < ref.count; ++r) {
-      int best = 257, best_k = -1;
-      for (int k = 0; k < cur.count; ++k) {
-        const int d = hammingDistance(ref.descriptors[r], cur.descriptors[k]);
-        if (d < best) {
-          best = d;
-          best_k = k;
-        }
-      }
-      best_of_ref_[r] = best_k;
-    }
+    std::fill(best_ref_distance_.begin(), best_ref_distance_.begin() + ref.count, 257);
     for (int k = 0; k < cur.count; ++k) {
-      if (!f.valid[c][k]) continue;
       int best = 257, second = 257, best_r = -1;
       for (int r = 0; r < ref.count; ++r) {
         const int d = hammingDistance(cur.descriptors[k], ref.descriptors[r]);
+        if (d < best_ref_distance_[r]) {
+          best_ref_distance_[r] = d;
+          best_of_ref_[r] = k;
+        }
         if (d < best) {
           second = best;
           best = d;
@@ -59,9 +55,12 @@ int Initializer::matchToReference(const FrameFeatures& f) {
           second = d;
         }
       }
-      if (best_r < 0 || best > kMaxHamming || !passesRatioTest(best, second, kRatio) || best_of_ref_[best_r] != k)
-        continue;
-      if (!reference_.valid[c][best_r]) continue;
+      const bool passes = f.valid[c][k] && best_r >= 0 && best <= kMaxHamming && passesRatioTest(best, second, kRatio);
+      candidate_of_cur_[k] = passes ? best_r : -1;
+    }
+    for (int k = 0; k < cur.count; ++k) {
+      const int best_r = candidate_of_cur_[k];
+      if (best_r < 0 || best_of_ref_[best_r] != k || !reference_.valid[c][best_r]) continue;
       RelativeCorrespondence m;
       m.camera1 = c;
       m.bearing1 = reference_.bearings[c][best_r];

@@ -103,6 +103,32 @@ TEST(RelativePose, SampsonFullJacobianMatchesNumericAwayFromTheSolution) {
   EXPECT_GT(checked, 10);  // the test covers what the held derivative misses
 }
 
+// Rays through the origin (one camera) take a shorter form of the error that leaves out their zero centres. It
+// must agree with the general form, here reached by a centre too small to change any value, and with central
+// differences, at poses away from the solution.
+TEST(RelativePose, CentralRaysGiveTheGeneralFormsErrorAndDerivatives) {
+  const Rig rig = nonOverlappingRig();
+  SceneRandom r(7);
+  const TwoFrames f = makeTwoFrames(rig, motion(25, Vec3(0.5, -0.1, 0.7)), 40, 1.0, 0.0, r);
+  const SE3 T = f.T_1_2 * SE3(so3Exp(Vec3(-0.2, 0.1, 0.15)), Vec3(-0.3, 0.2, 0.1));
+  const Vec3 negligible(1e-300, 0, 0);
+  for (const RelativeCorrespondence& m : f.matches) {
+    const Vec3 d1 = m.bearing1.normalized(), d2 = m.bearing2.normalized();
+    const relative_pose_detail::RayPair central{Vec3::Zero(), d1, Vec3::Zero(), d2};
+    const relative_pose_detail::RayPair general{negligible, d1, negligible, d2};
+    Eigen::Matrix<double, 1, 6> J_held_c, J_c, J_held_g, J_g;
+    const double e_c = relative_pose_detail::sampsonError(central, T, &J_held_c, &J_c);
+    const double e_g = relative_pose_detail::sampsonError(general, T, &J_held_g, &J_g);
+    EXPECT_NEAR(e_c, e_g, 1e-15);
+    for (int k = 0; k < 6; ++k) {
+      EXPECT_NEAR(J_held_c(k), J_held_g(k), 1e-12) << k;
+      EXPECT_NEAR(J_c(k), J_g(k), 1e-12) << k;
+      const double numeric = numericSampsonDerivative(central, T, k, 1e-6);
+      EXPECT_NEAR(numeric, J_c(k), 1e-6 * std::max(1.0, std::abs(numeric))) << k;
+    }
+  }
+}
+
 // Three non-overlapping cameras 0.3 m apart, 30 degrees of rotation and 1 m of translation,
 // 0.3 px noise and 20% outliers: metric translation within a few percent, consistent with the
 // reported scale uncertainty, and the inlier set right.

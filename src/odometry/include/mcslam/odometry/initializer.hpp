@@ -56,7 +56,9 @@ class Initializer {
   uint64_t reference_index_ = 0;
   bool has_reference_ = false;
   std::vector<RelativeCorrespondence> correspondences_;
-  std::vector<int32_t> best_of_ref_;
+  // matchToReference's one pass over a camera's distances: the nearest current keypoint of each reference
+  // keypoint, and the nearest reference keypoint of each current one that passed its own tests (-1 otherwise).
+  std::vector<int32_t> best_of_ref_, best_ref_distance_, candidate_of_cur_;
   // Up to scale from the one camera whose 5-point pose has the most inliers (rig without overlap).
   const RelativePoseResult& upToScale(uint64_t frame_index, SE3& T_ref_cur);
 
