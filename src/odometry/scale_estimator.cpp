@@ -144,7 +144,7 @@ class ScaleEstimator::Problem final : public backend::LeastSquaresProblem {
   ReducedVec step_;
 };
 
-bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
+bool ScaleEstimator::refine(int steps, double& c, double& u_step, int* taken) {
   // The trust region from mu = 1e-6; ten refusals in a row (each re-fits every landmark) end it: the window is at
   // its minimum.
   backend::LoopOptions loop;
@@ -155,7 +155,20 @@ bool ScaleEstimator::refine(int steps, double& c, double& u_step) {
   const backend::LoopSummary summary = backend::minimize(problem, loop);
   c = problem.cost();
   u_step = problem.uStep();
+  if (taken) *taken = summary.steps;
   return !summary.failed;
+}
+
+bool ScaleEstimator::refineNearUnit(double& c, double& u_step) {
+  const double scale_before = scaleOfPoses();
+  saveWindow(kf_start_, lm_start_);
+  int taken = 0;
+  if (refine(kRefineSteps, c, u_step, &taken) && taken > 0 &&
+      std::abs(std::log(scaleOfPoses() / scale_before)) <= std::log(kProfileRatio)) {
+    return true;
+  }
+  restoreWindow(kf_start_, lm_start_);
+  return false;
 }
 
 double ScaleEstimator::scaleOfPoses() const {
@@ -360,27 +373,33 @@ bool ScaleEstimator::prepare(const Map& map, ScaleEstimate& out) {
   return nl_ >= 20;
 }
 
-void ScaleEstimator::solve(double max_ratio, ScaleEstimate& out) {
+void ScaleEstimator::solve(double max_ratio, bool unit_known, ScaleEstimate& out) {
   const double scale_before = scaleOfPoses();
   if (!(scale_before > 0)) return;
-
-  // 1. Coarse (max_ratio > 1): the profile brings a map whose unit is far off into the basin. It only chooses the
-  //    basin: a sample of the landmarks is enough for that (it re-fits the window at every factor it tries), and
-  //    the others then take the factor it chose.
-  if (max_ratio > 1.0) {
-    const int all = nl_;
-    nl_ = np_;
-    const bool found = profileScale(max_ratio);
-    const double factor = scaleOfPoses() / scale_before;
-    nl_ = all;
-    if (!found) return;
-    for (int l = np_; l < nl_; ++l) lm_p_[l] *= factor;
-  }
-
-  // 2. Fine: Levenberg-Marquardt on the whole window, the scale free; the last system gives the marginal sigma.
   double c = 0, last_u_step = 0, chi2 = 0;
   int residuals = 0;
-  if (!refine(kRefineSteps, c, last_u_step) || !reducedSystem(chi2, residuals)) return;
+  // A known unit is refined from where it is; a refinement that finds no minimum near it (a window the map's
+  // last steps distorted, whose fit would otherwise pass for a precise estimate) gets the coarse search.
+  const bool refined = unit_known && max_ratio > 1.0 && refineNearUnit(c, last_u_step);
+
+  if (!refined) {
+    // 1. Coarse (max_ratio > 1): the profile brings a map whose unit is far off into the basin. It only chooses
+    //    the basin: a sample of the landmarks is enough for that (it re-fits the window at every factor it tries),
+    //    and the others then take the factor it chose.
+    if (max_ratio > 1.0) {
+      const int all = nl_;
+      nl_ = np_;
+      const bool found = profileScale(max_ratio);
+      const double factor = scaleOfPoses() / scale_before;
+      nl_ = all;
+      if (!found) return;
+      for (int l = np_; l < nl_; ++l) lm_p_[l] *= factor;
+    }
+    // 2. Fine: Levenberg-Marquardt on the whole window, the scale free.
+    if (!refine(kRefineSteps, c, last_u_step)) return;
+  }
+  // The last system gives the marginal sigma.
+  if (!reducedSystem(chi2, residuals)) return;
   // A refinement that still moved the scale by more than its sigma has not found the window's minimum: its
   // curvature says nothing about the scale.
   if (!(last_u_step * last_u_step <= scale_variance_)) return;
@@ -396,7 +415,7 @@ void ScaleEstimator::solve(double max_ratio, ScaleEstimate& out) {
 
 ScaleEstimate ScaleEstimator::estimate(const Map& map, double max_ratio) {
   ScaleEstimate out;
-  if (prepare(map, out)) solve(max_ratio, out);
+  if (prepare(map, out)) solve(max_ratio, false, out);
   return out;
 }
 

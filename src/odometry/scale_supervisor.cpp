@@ -17,20 +17,21 @@ namespace {
 // rig whose scale never converges).
 constexpr double kMinWindowTurnRad = 2.0 * M_PI / 180.0;
 // The profile search over the whole of OdometryOptions::scale_search_ratio runs while the unit is arbitrary. Once
-// the combined windows know it to kKnownSigma, or it has converged, the refinement starts from the map's unit: the
-// profile re-fits the window at every factor it tries, most of an estimate's cost (BENCHMARKS.md section 7 for
-// what that changes).
+// the combined windows know it to kKnownSigma, or it has converged, the refinement starts from the map's unit and
+// the profile (which re-fits the window at every factor it tries, most of an estimate's cost) runs only where that
+// refinement finds no minimum near the unit (ScaleEstimator::solve; BENCHMARKS.md section 7).
 constexpr double kKnownSigma = 0.2;
 
 }  // namespace
 
 struct ScaleSupervisor::EstimateJob final : BackgroundJob {
   void run() override {
-    if (prepared) estimator->solve(ratio, result);
+    if (prepared) estimator->solve(ratio, unit_known, result);
   }
   ScaleEstimator* estimator = nullptr;
   bool prepared = false;
   double ratio = 1;
+  bool unit_known = false;
   ScaleEstimate result;
   double rotation_travelled = 0;  // the rig's, at the copy
   uint64_t frame_index = 0;       // of the keyframe copied
@@ -84,7 +85,8 @@ void ScaleSupervisor::startEstimate(const Map& map, const RigState& rig, double 
   if (!unscaled_start_ || !estimator_ || in_flight_) return;
   if (windowTurn(map) < kMinWindowTurnRad) return;
   const bool scale_converged = rig.scaleConverged();
-  job_->ratio = scale_converged || filter_->sigma() <= kKnownSigma ? 1.0 : options_.scale_search_ratio;
+  job_->ratio = options_.scale_search_ratio;
+  job_->unit_known = scale_converged || filter_->sigma() <= kKnownSigma;
   job_->rotation_travelled = rotation_travelled;
   job_->frame_index = frame_index;
   estimator_->follow(rig);
@@ -107,7 +109,10 @@ ScaleSupervisor::Rescale ScaleSupervisor::takeEstimate(const Map& map, const Rig
                                                        OdometryStats& stats) {
   Rescale r;
   if (!in_flight_) return r;
-  endEstimate();  // waits for it: what follows depends on the estimate, never on the thread's timing
+  // A live rig takes it at the first settled keyframe that finds it done; otherwise this waits for it, and what
+  // follows depends on the estimate, never on the thread's timing.
+  if (!options_.repeatable && task_ && !task_->ready()) return r;
+  endEstimate();
   if (stale_) {
     stale_ = false;
     return r;

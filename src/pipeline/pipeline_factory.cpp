@@ -16,6 +16,7 @@ std::unique_ptr<FrameProcessor> createPipeline(const YAML::Node& slam, const std
                                                bool live) {
   PipelineConfig config = parsePipelineConfig(slam, source, rig);
   config.places.repeatable = !live;
+  config.odometry.repeatable = !live;
   return std::make_unique<SlamPipeline>(rig, config);
 }
 

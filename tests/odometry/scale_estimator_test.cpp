@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <thread>
 
 #include "alloc_testing.hpp"
 #include "mcslam/calib/calibration_io.hpp"
@@ -85,6 +86,25 @@ TEST(ScaleEstimator, FindsTheMetricScaleOfATurningWindow) {
   }
 }
 
+// A unit taken as known is refined from where it is; when that refinement finds no minimum near it (the map's
+// unit is in fact far off), the coarse search runs after all: the estimate is the window's, not a refinement
+// stopped far from its minimum, or one that never moved, passed off as precise.
+TEST(ScaleEstimator, AKnownUnitFarFromTheWindowsGetsTheCoarseSearch) {
+  const Rig rig = test::nonOverlappingRig3();
+  for (double map_scale : {0.2, 3.0, 5.0}) {
+    Map map(rig, 2000, 14, 4000);
+    buildWindow(rig, map, 60.0, map_scale, 0.5);
+    ScaleEstimator est(rig, 4000, 8 * 3 * 2000, 14, 1.2f, 8);
+    ScaleEstimate e;
+    ASSERT_TRUE(est.prepare(map, e));
+    est.solve(30.0, true, e);
+    std::printf("map scale %.2f, unit taken as known: estimate %.4f (expected %.4f), sigma %.4f\n", map_scale, e.scale,
+                1.0 / map_scale, e.relative_sigma);
+    ASSERT_TRUE(e.ok);
+    EXPECT_NEAR(e.scale * map_scale, 1.0, 3.0 * e.relative_sigma);
+  }
+}
+
 // Without rotation the lever arms move with the body and the scale stays unknown: a sigma far above 100%
 // (about 5000% here) or no estimate, never a confident wrong answer. The damping that steadies the Gauss-Newton
 // step once posed as information here (21%).
@@ -115,6 +135,42 @@ TEST(ScaleEstimator, EstimatesAllocateNothing) {
   EXPECT_TRUE(full.ok);
   EXPECT_EQ(full.keyframes, 8);
   EXPECT_EQ(smaller.keyframes, 5);
+}
+
+// A live rig (mcslamd) takes the estimate at the first settled keyframe that finds it done, never waiting for it:
+// the keyframes before that take nothing, and the one that takes it gets the rescale a repeatable run gets.
+TEST(ScaleSupervisor, ALiveRigTakesTheEstimateOnceDoneWithTheSameRescale) {
+  const Rig rig = test::nonOverlappingRig3();
+  RigState state(rig);
+  state.setScale(ScaleStatus::Unscaled);
+  ScaleSupervisor::Rescale taken[2];
+  for (const bool repeatable : {true, false}) {
+    Map map(rig, 2000, 14, 4000);
+    buildWindow(rig, map, 60.0, 2.5, 0.5);
+    OdometryOptions options;
+    options.repeatable = repeatable;
+    ScaleSupervisor supervisor(rig, options, 2000);
+    supervisor.start(true);
+    OdometryStats stats;
+    supervisor.startEstimate(map, state, 1.0, 10);
+    ScaleSupervisor::Rescale& r = taken[repeatable ? 0 : 1];
+    // Keyframes come until one finds it done (a repeatable run waits at the first).
+    int keyframes = 0;
+    for (; keyframes < 100000 && stats.scale_estimates == 0; ++keyframes) {
+      r = supervisor.takeEstimate(map, state, 13 + keyframes, stats);
+      if (stats.scale_estimates == 0) {
+        EXPECT_FALSE(r.apply);
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+      }
+    }
+    EXPECT_EQ(stats.scale_estimates, 1u);
+    if (repeatable) {
+      EXPECT_EQ(keyframes, 1);
+    }
+    ASSERT_TRUE(r.apply) << "repeatable " << repeatable;
+  }
+  EXPECT_EQ(taken[0].s, taken[1].s);
+  EXPECT_EQ(taken[0].center, taken[1].center);
 }
 
 // An estimate is copied out of the map at one settled keyframe and taken at the next, with the same result whether

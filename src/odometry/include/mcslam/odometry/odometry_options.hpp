@@ -79,8 +79,12 @@ struct OdometryOptions {
   // The solve runs on a thread of its own while tracking goes on with the next frames; its result is applied at a
   // fixed frame, so the output does not depend on timing. A keyframe's own pose is then the tracked one (the
   // optimized pose is what the following frames continue from). The scale estimate of a map started up to scale
-  // runs on a thread of its own with it, taken at the next settled keyframe.
+  // runs on a thread of its own with it, taken at the next settled keyframe (see `repeatable`).
   bool backend_thread = true;
+  // true: the scale estimate is taken at the settled keyframe after the one that started it, waiting for it if need
+  // be, so that runs repeat exactly (mcslam-run); false: at the first settled keyframe that finds it done, so that
+  // no frame waits for it (mcslamd, a live rig). Set by the program, not by the configuration file.
+  bool repeatable = true;
   // The frame, counted from the keyframe, before which its solve is applied (1: the next one), for maps that start
   // metric (cameras that overlap). Later spreads the solve over more frame periods instead of stalling one frame
   // for it, but the frames between are tracked against the map before the solve; a new keyframe, a loss or a new

@@ -61,9 +61,10 @@ class ScaleEstimator {
   ScaleEstimate estimate(const Map& map, double max_ratio);
   // estimate() in two halves, so that the second can run on another thread while the map changes. prepare()
   // copies the window out of the map (false: too few keyframes or landmarks, `out` says how many); solve() works
-  // on the copy only and completes `out`.
+  // on the copy only and completes `out`. With `unit_known` the refinement starts from the map's unit, and the
+  // coarse search runs only when it finds no minimum within one profile factor of it.
   bool prepare(const Map& map, ScaleEstimate& out);
-  void solve(double max_ratio, ScaleEstimate& out);
+  void solve(double max_ratio, bool unit_known, ScaleEstimate& out);
   static constexpr int kMaxKeyframes = 16;
   static constexpr int kMinLandmarkKeyframes = 3;
   // The profile's landmarks: an even sample of the window's, at most this many.
@@ -93,7 +94,10 @@ class ScaleEstimator {
   // Up to `steps` Levenberg-Marquardt steps from kf_T_ / lm_p_ (only steps that lower the cost are taken).
   // c: the cost at the end; u_step: how much the last step taken moved u (first order). False when the
   // system is not finite.
-  bool refine(int steps, double& c, double& u_step);
+  bool refine(int steps, double& c, double& u_step, int* taken = nullptr);
+  // The refinement from the map's unit when that unit is known: false (the window restored) when it took no step
+  // or moved the scale past one profile factor, a minimum outside the basin the unit is known to be in.
+  bool refineNearUnit(double& c, double& u_step);
   void scaleWindow(double s);  // keyframe positions and landmarks times s, about the centre
   void saveWindow(std::vector<SE3>& kf, std::vector<Vec3>& lm) const;
   void restoreWindow(const std::vector<SE3>& kf, const std::vector<Vec3>& lm);

@@ -40,9 +40,10 @@ class ScaleSupervisor {
     bool converged = false;  // the first rescale of a certain estimate: the map is metric from now on
   };
   // At each settled keyframe (frame `frame_index`), in this order: takeEstimate() waits for the estimate
-  // startEstimate() began at the last one and combines it (updating the scale counters of `stats`); the caller applies
-  // the rescale it returns; then startEstimate() copies the window of the map's newest keyframes out, with the
-  // extrinsics of `rig`, and starts its estimate when the window turned.
+  // startEstimate() began at the last one (with OdometryOptions::repeatable false, takes it only if it is done) and
+  // combines it (updating the scale counters of `stats`); the caller applies the rescale it returns; then
+  // startEstimate() copies the window of the map's newest keyframes out, with the extrinsics of `rig`, and starts
+  // its estimate when the window turned and none is in flight.
   Rescale takeEstimate(const Map& map, const RigState& rig, uint64_t frame_index, OdometryStats& stats);
   void startEstimate(const Map& map, const RigState& rig, double rotation_travelled, uint64_t frame_index);
   // Heap allocations made on the supervisor's thread so far (0 without one).

@@ -21,7 +21,8 @@ void validatePipelineConfig(const YAML::Node& slam_section, const std::string& s
 std::string effectivePipelineConfig(const YAML::Node& slam_section, const std::string& source, const Rig& rig);
 
 // `live`: a rig's frames as they come (mcslamd), where no frame waits for background work (a loop's correction
-// lands at the first frame it is ready), instead of a run that repeats exactly.
+// lands at the first frame it is ready, a scale estimate at the first settled keyframe), instead of a run that
+// repeats exactly.
 std::unique_ptr<FrameProcessor> createPipeline(const YAML::Node& slam_section, const std::string& source,
                                                const Rig& rig, bool live = false);
 
