@@ -185,7 +185,10 @@ double sampsonErrorOf(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 
   Eigen::Matrix<double, 1, 6> de;
   de.leftCols<3>() = Rd2.cross(m.d1).transpose();
   Vec3 dphi = Rt_d1_x_t.cross(m.d2);
-  if constexpr (!kCentral) dphi += Rt_d1.cross(m2) + Rt_m1.cross(m.d2);
+  if constexpr (!kCentral) {
+    dphi += Rt_d1.cross(m2);  // in the general form's order of sums: the same rounding
+    dphi += Rt_m1.cross(m.d2);
+  }
   de.rightCols<3>() = -dphi.transpose();
   if (J) *J = de / s;
   if (J_full) {

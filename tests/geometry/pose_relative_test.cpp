@@ -112,6 +112,7 @@ TEST(RelativePose, CentralRaysGiveTheGeneralFormsErrorAndDerivatives) {
   const TwoFrames f = makeTwoFrames(rig, motion(25, Vec3(0.5, -0.1, 0.7)), 40, 1.0, 0.0, r);
   const SE3 T = f.T_1_2 * SE3(so3Exp(Vec3(-0.2, 0.1, 0.15)), Vec3(-0.3, 0.2, 0.1));
   const Vec3 negligible(1e-300, 0, 0);
+  ASSERT_GT(f.matches.size(), 20u);
   for (const RelativeCorrespondence& m : f.matches) {
     const Vec3 d1 = m.bearing1.normalized(), d2 = m.bearing2.normalized();
     const relative_pose_detail::RayPair central{Vec3::Zero(), d1, Vec3::Zero(), d2};
