@@ -145,8 +145,8 @@ class RelativePoseProblem final : public backend::LeastSquaresProblem {
 
 namespace {
 
-// kCentral: both centres are zero (one camera's rays), and the terms they enter are left out. Those terms are
-// exact zeros, so both forms give the same values; the central one in about half the operations.
+// kCentral: both centres are zero (one camera's rays), and the terms they enter are left out: they are exact
+// zeros, so both forms give the same values, the central one with fewer operations.
 template <bool kCentral>
 double sampsonErrorOf(const RayPair& m, const SE3& T_1_2, Eigen::Matrix<double, 1, 6>* J,
                       Eigen::Matrix<double, 1, 6>* J_full) {
@@ -229,8 +229,8 @@ SE3 refineRelativePose(std::span<const RayPair> matches, std::span<const uint8_t
   loop.max_steps = 100;
   loop.small_step = backend::LoopOptions::SmallStep::EndsOnceTaken;
   loop.min_step_norm = 1e-12;
-  // Where the motion is small the cost is nearly flat along the translation's direction: without a tolerance the
-  // loop crawls there to its step limit, changing the pose by far less than the bearings' noise.
+  // Where the motion is small the cost is nearly flat along the translation's direction and Gauss-Newton converges
+  // only linearly: the steps after this change the pose by far less than the bearings' noise.
   loop.function_tolerance = 1e-8;
   loop.stop_on_failed_solve = true;
   backend::minimize(problem, loop);

@@ -66,6 +66,20 @@ void buildWindow(const Rig& rig, Map& map, double turn_deg, double map_scale, do
   }
 }
 
+// A supervisor of a map started up to scale, over a window that turns 60 degrees in a unit 2.5x off.
+struct SupervisedWindow {
+  explicit SupervisedWindow(const OdometryOptions& options) : supervisor(rig, options, 2000) {
+    state.setScale(ScaleStatus::Unscaled);
+    buildWindow(rig, map, 60.0, 2.5, 0.5);
+    supervisor.start(true);
+  }
+  const Rig rig = test::nonOverlappingRig3();
+  RigState state{rig};
+  Map map{rig, 2000, 14, 4000};
+  ScaleSupervisor supervisor;
+  OdometryStats stats;
+};
+
 }  // namespace
 
 // The estimator finds the factor that makes a wrongly scaled window metric when the window turns.
@@ -140,24 +154,18 @@ TEST(ScaleEstimator, EstimatesAllocateNothing) {
 // A live rig (mcslamd) takes the estimate at the first settled keyframe that finds it done, never waiting for it:
 // the keyframes before that take nothing, and the one that takes it gets the rescale a repeatable run gets.
 TEST(ScaleSupervisor, ALiveRigTakesTheEstimateOnceDoneWithTheSameRescale) {
-  const Rig rig = test::nonOverlappingRig3();
-  RigState state(rig);
-  state.setScale(ScaleStatus::Unscaled);
   ScaleSupervisor::Rescale taken[2];
   for (const bool repeatable : {true, false}) {
-    Map map(rig, 2000, 14, 4000);
-    buildWindow(rig, map, 60.0, 2.5, 0.5);
     OdometryOptions options;
     options.repeatable = repeatable;
-    ScaleSupervisor supervisor(rig, options, 2000);
-    supervisor.start(true);
-    OdometryStats stats;
-    supervisor.startEstimate(map, state, 1.0, 10);
+    SupervisedWindow w(options);
+    OdometryStats& stats = w.stats;
+    w.supervisor.startEstimate(w.map, w.state, 1.0, 10);
     ScaleSupervisor::Rescale& r = taken[repeatable ? 0 : 1];
     // Keyframes come until one finds it done (a repeatable run waits at the first); CTest's timeout bounds the loop.
     int keyframes = 0;
     for (; stats.scale_estimates == 0; ++keyframes) {
-      r = supervisor.takeEstimate(map, state, 13 + keyframes, stats);
+      r = w.supervisor.takeEstimate(w.map, w.state, 13 + keyframes, stats);
       if (stats.scale_estimates == 0) {
         EXPECT_FALSE(r.apply);
         std::this_thread::sleep_for(std::chrono::microseconds(100));
@@ -176,28 +184,22 @@ TEST(ScaleSupervisor, ALiveRigTakesTheEstimateOnceDoneWithTheSameRescale) {
 // An estimate is copied out of the map at one settled keyframe and taken at the next, with the same result whether
 // it ran on the supervisor's thread or at once, and whatever the map did in between (tracking goes on).
 TEST(ScaleSupervisor, AnEstimateStartedAtOneKeyframeIsTakenAtTheNextWhereverItRan) {
-  const Rig rig = test::nonOverlappingRig3();
-  RigState state(rig);
-  state.setScale(ScaleStatus::Unscaled);
   ScaleSupervisor::Rescale taken[2];
   for (const bool thread : {false, true}) {
-    Map map(rig, 2000, 14, 4000);
-    buildWindow(rig, map, 60.0, 2.5, 0.5);
     OdometryOptions options;
     options.backend_thread = thread;
-    ScaleSupervisor supervisor(rig, options, 2000);
-    supervisor.start(true);
-    OdometryStats stats;
-    EXPECT_FALSE(supervisor.takeEstimate(map, state, 10, stats).apply);  // none was started
-    supervisor.startEstimate(map, state, 1.0, 10);
-    const int newest = map.newestKeyframe();
-    map.keyframe(newest).T_w_b.t += Vec3(3.0, 0, 0);  // the copy is what counts
+    SupervisedWindow w(options);
+    OdometryStats& stats = w.stats;
+    EXPECT_FALSE(w.supervisor.takeEstimate(w.map, w.state, 10, stats).apply);  // none was started
+    w.supervisor.startEstimate(w.map, w.state, 1.0, 10);
+    const int newest = w.map.newestKeyframe();
+    w.map.keyframe(newest).T_w_b.t += Vec3(3.0, 0, 0);  // the copy is what counts
     ScaleSupervisor::Rescale& r = taken[thread ? 1 : 0];
-    r = supervisor.takeEstimate(map, state, 13, stats);
+    r = w.supervisor.takeEstimate(w.map, w.state, 13, stats);
     EXPECT_EQ(stats.scale_estimates, 1u);
     ASSERT_TRUE(r.apply) << "thread " << thread;
     EXPECT_NEAR(r.s * 2.5, 1.0, 0.05);
-    EXPECT_FALSE(supervisor.takeEstimate(map, state, 16, stats).apply);  // taken once
+    EXPECT_FALSE(w.supervisor.takeEstimate(w.map, w.state, 16, stats).apply);  // taken once
     EXPECT_EQ(stats.scale_estimates, 1u);
   }
   EXPECT_EQ(taken[0].s, taken[1].s);
@@ -206,18 +208,11 @@ TEST(ScaleSupervisor, AnEstimateStartedAtOneKeyframeIsTakenAtTheNextWhereverItRa
 
 // A new map drops the estimate in flight: its window belonged to the old one.
 TEST(ScaleSupervisor, ANewMapDropsTheEstimateInFlight) {
-  const Rig rig = test::nonOverlappingRig3();
-  RigState state(rig);
-  state.setScale(ScaleStatus::Unscaled);
-  Map map(rig, 2000, 14, 4000);
-  buildWindow(rig, map, 60.0, 2.5, 0.5);
-  ScaleSupervisor supervisor(rig, OdometryOptions{}, 2000);
-  supervisor.start(true);
-  OdometryStats stats;
-  supervisor.startEstimate(map, state, 1.0, 10);
-  supervisor.start(true);
-  EXPECT_FALSE(supervisor.takeEstimate(map, state, 13, stats).apply);
-  EXPECT_EQ(stats.scale_estimates, 0u);
+  SupervisedWindow w(OdometryOptions{});
+  w.supervisor.startEstimate(w.map, w.state, 1.0, 10);
+  w.supervisor.start(true);
+  EXPECT_FALSE(w.supervisor.takeEstimate(w.map, w.state, 13, w.stats).apply);
+  EXPECT_EQ(w.stats.scale_estimates, 0u);
 }
 
 // The filter says over how much rotation its estimates were gathered, from the first one it kept since it
