@@ -30,7 +30,7 @@ struct ScaleSupervisor::EstimateJob final : BackgroundJob {
   }
   ScaleEstimator* estimator = nullptr;
   bool prepared = false;
-  double ratio = 1;
+  double ratio = 1;  // the profile's range (OdometryOptions::scale_search_ratio)
   bool unit_known = false;
   ScaleEstimate result;
   double rotation_travelled = 0;  // the rig's, at the copy
@@ -48,6 +48,7 @@ ScaleSupervisor::ScaleSupervisor(const Rig& rig, const OdometryOptions& options,
   filter_ = std::make_unique<ScaleFilter>();
   job_ = std::make_unique<EstimateJob>();
   job_->estimator = estimator_.get();
+  job_->ratio = options.scale_search_ratio;
   if (options.backend_thread) task_ = std::make_unique<BackgroundTask>();
 }
 
@@ -85,7 +86,6 @@ void ScaleSupervisor::startEstimate(const Map& map, const RigState& rig, double 
   if (!unscaled_start_ || !estimator_ || in_flight_) return;
   if (windowTurn(map) < kMinWindowTurnRad) return;
   const bool scale_converged = rig.scaleConverged();
-  job_->ratio = options_.scale_search_ratio;
   job_->unit_known = scale_converged || filter_->sigma() <= kKnownSigma;
   job_->rotation_travelled = rotation_travelled;
   job_->frame_index = frame_index;
