@@ -13,6 +13,7 @@
 #include "daemon/config_names.hpp"
 #include "daemon/daemon.hpp"
 #include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/core/background_task.hpp"
 #include "mcslam/pipeline/pipeline_factory.hpp"
 #include "realtime/scheduling.hpp"
 #include "systemd/notifier.hpp"
@@ -257,7 +258,8 @@ int runDaemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> proces
   const sigset_t signals = handledSignals();
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  restrictCpus(config.realtime.cpus);  // before the pipeline's and the daemon's threads, which inherit it
+  restrictCpus(config.realtime.cpus);                // before the pipeline's and the daemon's threads, which inherit it
+  setBackgroundThreadSetup(&setUpBackgroundThread);  // before the pipeline's first background job
   SystemdNotifier notifier;
   if (!processor) processor = createPipeline(config.slam, config.file, config.rig, /*live=*/true);
   Daemon daemon(config, std::move(processor));

@@ -7,6 +7,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include <spdlog/spdlog.h>
+
 namespace mcslam::platform {
 
 void nameThisThread(const char* name) {
@@ -22,6 +24,17 @@ std::string setRealtimePriority(int priority) {
   p.sched_priority = priority;
   const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
   return rc == 0 ? std::string() : std::string("SCHED_FIFO ") + std::to_string(priority) + ": " + std::strerror(rc);
+}
+
+std::string useBatchScheduling() {
+  const sched_param p{};  // SCHED_BATCH has no priority: 0
+  const int rc = pthread_setschedparam(pthread_self(), SCHED_BATCH, &p);
+  return rc == 0 ? std::string() : std::string("SCHED_BATCH: ") + std::strerror(rc);
+}
+
+void setUpBackgroundThread() {
+  if (const std::string why = useBatchScheduling(); !why.empty())
+    spdlog::warn("background thread: {}; it keeps the normal scheduling", why);
 }
 
 std::string lockAllMemory() {

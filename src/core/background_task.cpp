@@ -5,6 +5,11 @@
 #include "mcslam/core/alloc_counter.hpp"
 
 namespace mcslam {
+namespace {
+std::atomic<BackgroundThreadSetup> thread_setup{nullptr};
+}  // namespace
+
+void setBackgroundThreadSetup(BackgroundThreadSetup setup) { thread_setup.store(setup); }
 
 void BackgroundTask::start(BackgroundJob& job) {
   pool_.wait();
@@ -21,6 +26,10 @@ bool BackgroundTask::collect() {
 }
 
 void BackgroundTask::Runner::run(int /*task*/, int /*thread*/) {
+  if (!thread_set_up) {
+    thread_set_up = true;
+    if (const BackgroundThreadSetup setup = thread_setup.load()) setup();
+  }
   const uint64_t allocations_before = alloc::threadCount();
   const auto start = std::chrono::steady_clock::now();
   job->run();

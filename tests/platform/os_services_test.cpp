@@ -1,6 +1,8 @@
-// sd_notify datagrams, UDP pose datagrams, the TUM trajectory writer and pixel conversion.
+// sd_notify datagrams, UDP pose datagrams, the TUM trajectory writer, pixel conversion and the background threads'
+// scheduling class.
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -18,7 +20,9 @@
 #include "aravis/pixel_convert.hpp"
 #include "daemon/trajectory_writer.hpp"
 #include "mcslam/core/alloc_counter.hpp"
+#include "mcslam/core/background_task.hpp"
 #include "mcslam/core/error.hpp"
+#include "realtime/scheduling.hpp"
 #include "systemd/notifier.hpp"
 #include "test_support.hpp"
 #include "udp/udp_pose_sender.hpp"
@@ -306,4 +310,24 @@ TEST(PixelConvert, Mono8CopiesAndSizeMismatchIsRefused) {
   EXPECT_FALSE(convertToGrey(PixelLayout::Mono8, raw.data(), raw.size(), 5, 3, out));
   EXPECT_FALSE(convertToGrey(PixelLayout::Mono8, raw.data(), 10, 4, 3, out));
   EXPECT_THROW(pixelLayoutFromName("RGB8"), InputError);
+}
+
+namespace {
+class RecordPolicy final : public BackgroundJob {
+ public:
+  void run() override { policy = sched_getscheduler(0); }
+  int policy = -1;
+};
+}  // namespace
+
+TEST(BackgroundScheduling, TheDaemonsSetupPutsTheCoresBackgroundThreadsInTheBatchClassOnly) {
+  const int own_policy = sched_getscheduler(0);
+  setBackgroundThreadSetup(&setUpBackgroundThread);
+  RecordPolicy job;
+  BackgroundTask task;
+  task.start(job);
+  ASSERT_TRUE(task.collect());
+  setBackgroundThreadSetup(nullptr);
+  EXPECT_EQ(job.policy, SCHED_BATCH);
+  EXPECT_EQ(sched_getscheduler(0), own_policy);  // the thread that handed the job over keeps its class
 }

@@ -12,6 +12,13 @@ void nameThisThread(const char* name);
 // on success, else the reason (e.g. missing CAP_SYS_NICE / LimitRTPRIO), which the caller logs.
 std::string setRealtimePriority(int priority);
 
+// SCHED_BATCH for the calling thread: it still gets its fair share of the CPU, but a wake-up of it no longer
+// preempts the thread running (the frame's), which then finishes its frame first. For the core's background
+// threads (mcslam::setBackgroundThreadSetup). Empty string on success, else the reason.
+std::string useBatchScheduling();
+// useBatchScheduling() as the core's background thread setup: logs the reason if it fails.
+void setUpBackgroundThread();
+
 // mlockall(MCL_CURRENT | MCL_FUTURE): no page faults on the hot path. Empty string on success.
 std::string lockAllMemory();
 

@@ -18,6 +18,13 @@ class BackgroundJob {
   ~BackgroundJob() = default;
 };
 
+// What every task's thread runs once, before its first job (nullptr: nothing). The platform layer sets it to
+// lower the scheduling class of the background threads, so that a job woken by the frame's thread does not preempt
+// that thread while it still works on the frame; the core itself does not touch the OS. Process-wide; set it
+// before the first job starts.
+using BackgroundThreadSetup = void (*)();
+void setBackgroundThreadSetup(BackgroundThreadSetup setup);
+
 class BackgroundTask {
  public:
   BackgroundTask() = default;  // starts the thread (the only allocation)
@@ -45,6 +52,7 @@ class BackgroundTask {
   struct Runner final : PoolJob {
     void run(int task, int thread) override;
     BackgroundJob* job = nullptr;  // written by start() only while no job runs
+    bool thread_set_up = false;    // the task's thread only
     std::atomic<uint64_t> allocations{0};
     std::atomic<double> milliseconds{0};
   };
