@@ -80,14 +80,16 @@ WorldFigures measure(const std::string& world, unsigned seed) {
 }  // namespace
 
 // The regression guard on one world (indoor, seed 1); the study over several worlds and seeds is the disabled
-// test below. Measured 2248 points, 0.978 within 2%, 0.0156 more than 5% off (35, 22 of them two-view); before
-// two-view tracks were checked for a repetition along the curve (multiview: unique_two_view): 2463 points, 0.909
-// within 2%, 0.0857 off (211, 198 two-view). Study figures: BENCHMARKS.md section 3, "Repeating texture".
+// test below. Measured 2248 points, 0.978 within 2%, 0.0156 more than 5% off (35, 22 of them two-view) on x86-64,
+// 2276 points, 0.967 within, 0.0207 off (47) on arm64, whose render and floating point differ in the last bits;
+// before two-view tracks were checked for a repetition along the curve (multiview: unique_two_view): 2463 points,
+// 0.909 within 2%, 0.0857 off (211, 198 two-view). The bound sits between the two, not at one machine's figure.
+// Study figures: BENCHMARKS.md section 3, "Repeating texture".
 TEST(SimRepeatingTexture, FewMultiViewPointsTakeTheWrongRepetition) {
   const WorldFigures w = measure("indoor", 1);
   ASSERT_GT(w.total.points, 1000);
   EXPECT_GE(w.total.within, 0.95 * w.total.points);
-  EXPECT_LE(w.total.off, 0.02 * w.total.points);
+  EXPECT_LE(w.total.off, 0.035 * w.total.points);
 }
 
 // Run with --gtest_also_run_disabled_tests --gtest_filter='*RepeatingTextureStudy*': the three worlds, two seeds
