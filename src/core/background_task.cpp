@@ -26,11 +26,11 @@ bool BackgroundTask::collect() {
 }
 
 void BackgroundTask::Runner::run(int /*task*/, int /*thread*/) {
+  const uint64_t allocations_before = alloc::threadCount();  // the setup's count too: it may run after warm-up
   if (!thread_set_up) {
     thread_set_up = true;
     if (const BackgroundThreadSetup setup = thread_setup.load()) setup();
   }
-  const uint64_t allocations_before = alloc::threadCount();
   const auto start = std::chrono::steady_clock::now();
   job->run();
   milliseconds.store(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count(),

@@ -18,6 +18,15 @@ void recordSetup() {
   setup_thread.store(std::this_thread::get_id());
 }
 
+// Sets the process-wide hook for one test and clears it however the test ends.
+class SetupHook {
+ public:
+  explicit SetupHook(BackgroundThreadSetup setup) { setBackgroundThreadSetup(setup); }
+  ~SetupHook() { setBackgroundThreadSetup(nullptr); }
+  SetupHook(const SetupHook&) = delete;
+  SetupHook& operator=(const SetupHook&) = delete;
+};
+
 class RecordThread final : public BackgroundJob {
  public:
   void run() override {
@@ -30,7 +39,7 @@ class RecordThread final : public BackgroundJob {
 
 TEST(BackgroundTask, TheThreadSetupRunsOnceOnEachTasksThreadBeforeItsFirstJob) {
   setups.store(0);
-  setBackgroundThreadSetup(&recordSetup);
+  const SetupHook hook(&recordSetup);
   RecordThread job;
   BackgroundTask first, second;
   for (int round = 0; round < 3; ++round) {
@@ -45,12 +54,11 @@ TEST(BackgroundTask, TheThreadSetupRunsOnceOnEachTasksThreadBeforeItsFirstJob) {
   ASSERT_TRUE(second.collect());
   EXPECT_EQ(setups.load(), 2);
   EXPECT_EQ(setup_thread.load(), job.thread);
-  setBackgroundThreadSetup(nullptr);
 }
 
 TEST(BackgroundTask, WithoutASetupJobsRunAsBefore) {
   setups.store(0);
-  setBackgroundThreadSetup(nullptr);
+  const SetupHook hook(nullptr);
   RecordThread job;
   BackgroundTask task;
   task.start(job);

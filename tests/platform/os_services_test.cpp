@@ -324,10 +324,14 @@ TEST(BackgroundScheduling, TheDaemonsSetupPutsTheCoresBackgroundThreadsInTheBatc
   const int own_policy = sched_getscheduler(0);
   setBackgroundThreadSetup(&setUpBackgroundThread);
   RecordPolicy job;
-  BackgroundTask task;
-  task.start(job);
-  ASSERT_TRUE(task.collect());
-  setBackgroundThreadSetup(nullptr);
+  bool collected = false;
+  {
+    BackgroundTask task;
+    task.start(job);
+    collected = task.collect();
+  }
+  setBackgroundThreadSetup(nullptr);  // before any assertion can end the test
+  ASSERT_TRUE(collected);
   EXPECT_EQ(job.policy, SCHED_BATCH);
   EXPECT_EQ(sched_getscheduler(0), own_policy);  // the thread that handed the job over keeps its class
 }
