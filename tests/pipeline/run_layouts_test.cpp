@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "mcslam/dataset/dataset.hpp"
 #include "mcslam/dataset/trajectory.hpp"
@@ -138,4 +141,43 @@ TEST_F(RunLayouts, ARunThatGivesNoPoseAtAllFailsAndSaysWhy) {
       << out;
   EXPECT_NE(out.find("no frame of 1 got a pose"), std::string::npos) << out;
   EXPECT_EQ(test::readFile(trajectory).rfind("# ", 0), 0u) << "the (empty) trajectory is still written";
+}
+
+// The per-frame times say which frames a percentile is made of: one line per frame given to the SLAM, with the
+// dataset's index (after --start), the state and the keyframe flag the stats file counts, and each stage's time.
+TEST_F(RunLayouts, FrameTimesListEveryFrameWithItsStateAndWhetherItMadeAKeyframe) {
+  const std::string csv_path = dir_->file("times.csv"), stats_path = dir_->file("times.json");
+  std::string out;
+  ASSERT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --quiet --start 10 --frames 30" +
+                                 " --out " + dir_->file("times.tum") + " --stats " + stats_path + " --frame-times " +
+                                 csv_path,
+                             &out),
+            0)
+      << out;
+  std::istringstream csv(test::readFile(csv_path));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  EXPECT_EQ(line, "frame,t,state,keyframe,features_ms,tracking_ms,optimization_ms,place_memory_ms,total_ms");
+  const Trajectory trajectory = readTumTrajectory(dir_->file("times.tum"));
+  std::size_t rows = 0;
+  long keyframes = 0;
+  while (std::getline(csv, line)) {
+    std::istringstream row(line);
+    std::vector<std::string> f;
+    for (std::string field; std::getline(row, field, ',');) f.push_back(field);
+    ASSERT_EQ(f.size(), 9u) << line;
+    EXPECT_EQ(std::stoul(f[0]), 10 + rows) << line;
+    ASSERT_LT(rows, trajectory.size());
+    EXPECT_NEAR(std::stod(f[1]), toSeconds(trajectory[rows].t), 1e-6) << line;
+    EXPECT_EQ(f[2], "tracking") << line;  // a stereo pair tracks from its first frame
+    keyframes += std::stol(f[3]);
+    for (int stage = 4; stage < 8; ++stage) {
+      EXPECT_GE(std::stod(f[stage]), 0.0) << line;
+      EXPECT_LE(std::stod(f[stage]), std::stod(f[8]) + 1e-3) << line << ": a stage longer than the frame";
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 30u);
+  EXPECT_EQ(keyframes, jsonInt(test::readFile(stats_path), "keyframes"));
+  EXPECT_GT(keyframes, 1);
 }

@@ -29,7 +29,7 @@ namespace {
 
 struct RunOptions {
   std::string dataset_dir, calibration_path, config_path, cameras_text;
-  std::string out_path, keyframes_path, stats_path, extrinsics_path;
+  std::string out_path, keyframes_path, stats_path, frame_times_path, extrinsics_path;
   bool quiet = false, print_config = false, overlap = true;
   std::string log_level = "info";
   std::size_t max_frames = 0;
@@ -80,6 +80,8 @@ void addOptions(CLI::App& app, RunOptions& o) {
                  "the map is initialized, while lost, or while localizing in a loaded map); --stats counts them");
   app.add_option("--keyframes", o.keyframes_path, "Keyframe poses, TUM format");
   app.add_option("--stats", o.stats_path, "Timing per stage (mean, p99) and tracking states, JSON");
+  app.add_option("--frame-times", o.frame_times_path,
+                 "Each frame's stage times, tracking state and keyframe flag, CSV (which frames make the p99)");
   app.add_option("--extrinsics", o.extrinsics_path, "Camera extrinsics after online refinement, Kalibr camchain YAML");
   app.add_option("--frames", o.max_frames, "Process only the first N rig frames (0: all)");
   app.add_option("--start", o.first_frame, "Begin at rig frame N of the dataset (with --frames: N of them)");
@@ -331,6 +333,7 @@ int runDataset(const RunOptions& o) {
   if (!o.out_path.empty()) writeTumTrajectory(o.out_path, report.trajectory());
   if (!o.keyframes_path.empty()) writeTumTrajectory(o.keyframes_path, report.keyframes());
   if (!o.stats_path.empty()) report.writeStats(o.stats_path, pipeline, o.dataset_dir, ds.rig().size(), wall);
+  if (!o.frame_times_path.empty()) report.writeFrameTimes(o.frame_times_path, order);
   if (!o.extrinsics_path.empty()) writeKalibrRig(pipeline.refinedRig(), o.extrinsics_path);
   if (!o.map_out.empty()) saveMap(pipeline, o.map_out);
   if (!o.quiet) printSummary(pipeline, report, wall);
