@@ -36,6 +36,7 @@ ScaleEstimator::ScaleEstimator(const Rig& rig, int max_landmarks, int max_observ
   kf_best_.resize(kMaxKeyframes);
   T_c_b_.resize(rig.size());
   lm_p_.resize(max_landmarks);
+  eligible_.resize(max_landmarks);
   lm_start_.resize(max_landmarks);
   lm_best_.resize(max_landmarks);
   lm_first_.resize(static_cast<std::size_t>(max_landmarks) + 1);
@@ -297,26 +298,26 @@ int ScaleEstimator::windowViews(const Landmark& L) const {
 // test it could fail. The profile's share comes first: every stride-th of them, an even sample that keeps the
 // near points, which tell the scale best.
 void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
+  // One pass over the map's pool. The list cannot overflow: each landmark on it holds kMinLandmarkKeyframes of the
+  // window's keypoints, which the capacity counts (and the map holds no more landmarks than the capacity allows).
   int eligible = 0;
-  for (int lm = 0; lm < map.landmarkCapacity(); ++lm) {
+  for (int lm = 0; lm < map.landmarkCapacity() && eligible < static_cast<int>(eligible_.size()); ++lm) {
     const Landmark& L = map.landmark(lm);
-    if (L.alive && windowViews(L) >= kMinLandmarkKeyframes) ++eligible;
+    if (L.alive && windowViews(L) >= kMinLandmarkKeyframes) eligible_[eligible++] = lm;
   }
   const int stride = std::max(1, (eligible + kProfileLandmarks - 1) / kProfileLandmarks);
   nl_ = 0;
   no_ = 0;
-  appendLandmarks(map, center, stride, true);
+  appendLandmarks(map, center, eligible, stride, true);
   np_ = nl_;
-  if (stride > 1) appendLandmarks(map, center, stride, false);
+  if (stride > 1) appendLandmarks(map, center, eligible, stride, false);
   lm_first_[nl_] = no_;
 }
 
-void ScaleEstimator::appendLandmarks(const Map& map, const Vec3& center, int stride, bool profile_share) {
-  int eligible = 0;
-  for (int lm = 0; lm < map.landmarkCapacity() && nl_ < static_cast<int>(lm_p_.size()); ++lm) {
-    const Landmark& L = map.landmark(lm);
-    if (!L.alive || windowViews(L) < kMinLandmarkKeyframes) continue;
-    if ((eligible++ % stride == 0) != profile_share) continue;
+void ScaleEstimator::appendLandmarks(const Map& map, const Vec3& center, int eligible, int stride, bool profile_share) {
+  for (int e = 0; e < eligible && nl_ < static_cast<int>(lm_p_.size()); ++e) {
+    if ((e % stride == 0) != profile_share) continue;
+    const Landmark& L = map.landmark(eligible_[e]);
     int n = 0;
     for (int j = 0; j < L.obs_count; ++j) n += kf_slot_of_[L.obs[j].keyframe] >= 0 ? 1 : 0;
     if (no_ + n > static_cast<int>(obs_.size())) continue;

@@ -83,9 +83,9 @@ class ScaleEstimator {
   class Problem;                                              // the Levenberg-Marquardt problem of refine()
   bool selectWindow(const Map& map, ScaleEstimate& out);      // keyframes: kf_T_, oldest_, out's window fields
   void collectLandmarks(const Map& map, const Vec3& center);  // lm_p_, lm_first_, obs_, np_
-  // Appends the landmarks the window can use, with their window observations: every stride-th of them (the
-  // profile's share), or the others.
-  void appendLandmarks(const Map& map, const Vec3& center, int stride, bool profile_share);
+  // Appends the first `eligible` landmarks of eligible_ with their window observations: every stride-th of them
+  // (the profile's share), or the others.
+  void appendLandmarks(const Map& map, const Vec3& center, int eligible, int stride, bool profile_share);
   int windowViews(const Landmark& L) const;  // window keyframes that observe L
   bool profileScale(double max_ratio);       // the coarse search
   double cost();  // robust cost of the window as it is, every landmark at its best position for the poses
@@ -127,6 +127,7 @@ class ScaleEstimator {
   double held_u_ = 0;
   std::vector<int> kf_slot_of_;  // map keyframe slot -> window index (-1)
   std::vector<int> kf_order_;    // window index -> map keyframe slot (the first nk_), then the other live ones
+  std::vector<int> eligible_;    // map slots of the landmarks seen from enough window keyframes, in pool order
   std::vector<Vec3> lm_p_;       // per landmark: position relative to the centre
   std::vector<int> lm_first_;    // per landmark: first observation (lm_first_[l + 1] ends it)
   std::vector<Obs> obs_;
