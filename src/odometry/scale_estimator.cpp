@@ -297,13 +297,16 @@ int ScaleEstimator::windowViews(const Landmark& L) const {
 // there, so it agrees with the map's unit whether or not it is a lookalike. A third keyframe's observation is a
 // test it could fail. The profile's share comes first: every stride-th of them, an even sample that keeps the
 // near points, which tell the scale best.
-void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
-  // One pass over the map's pool. The list cannot overflow: each landmark on it holds kMinLandmarkKeyframes of the
-  // window's keypoints, which the capacity counts (and the map holds no more landmarks than the capacity allows).
+bool ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
+  // One pass over the map's pool. eligible_ holds min(max_landmarks, the window's keypoints) slots
+  // (ScaleSupervisor) and each landmark listed owns at least kMinLandmarkKeyframes of the window's keypoints, so
+  // only a map the estimator was not sized for fills it.
   int eligible = 0;
-  for (int lm = 0; lm < map.landmarkCapacity() && eligible < static_cast<int>(eligible_.size()); ++lm) {
+  for (int lm = 0; lm < map.landmarkCapacity(); ++lm) {
     const Landmark& L = map.landmark(lm);
-    if (L.alive && windowViews(L) >= kMinLandmarkKeyframes) eligible_[eligible++] = lm;
+    if (!L.alive || windowViews(L) < kMinLandmarkKeyframes) continue;
+    if (eligible == static_cast<int>(eligible_.size())) return false;
+    eligible_[eligible++] = lm;
   }
   const int stride = std::max(1, (eligible + kProfileLandmarks - 1) / kProfileLandmarks);
   nl_ = 0;
@@ -312,6 +315,7 @@ void ScaleEstimator::collectLandmarks(const Map& map, const Vec3& center) {
   np_ = nl_;
   if (stride > 1) appendLandmarks(map, center, eligible, stride, false);
   lm_first_[nl_] = no_;
+  return true;
 }
 
 void ScaleEstimator::appendLandmarks(const Map& map, const Vec3& center, int eligible, int stride, bool profile_share) {
@@ -367,8 +371,7 @@ bool ScaleEstimator::profileScale(double max_ratio) {
 
 bool ScaleEstimator::prepare(const Map& map, ScaleEstimate& out) {
   out = ScaleEstimate{};
-  if (!selectWindow(map, out)) return false;
-  collectLandmarks(map, out.center);
+  if (!selectWindow(map, out) || !collectLandmarks(map, out.center)) return false;
   out.landmarks = nl_;
   out.observations = no_;
   return nl_ >= 20;

@@ -143,8 +143,9 @@ TEST_F(RunLayouts, ARunThatGivesNoPoseAtAllFailsAndSaysWhy) {
   EXPECT_EQ(test::readFile(trajectory).rfind("# ", 0), 0u) << "the (empty) trajectory is still written";
 }
 
-// The per-frame times say which frames a percentile is made of: one line per frame given to the SLAM, with the
-// dataset's index (after --start), the state and the keyframe flag the stats file counts, and each stage's time.
+// The per-frame times say which frames a percentile is made of: one line per frame given to the SLAM, numbered as
+// the stats file numbers them and by the dataset's index (after --start), with the state and the keyframe flag the
+// stats file counts, and each stage's time.
 TEST_F(RunLayouts, FrameTimesListEveryFrameWithItsStateAndWhetherItMadeAKeyframe) {
   const std::string csv_path = dir_->file("times.csv"), stats_path = dir_->file("times.json");
   std::string out;
@@ -157,7 +158,8 @@ TEST_F(RunLayouts, FrameTimesListEveryFrameWithItsStateAndWhetherItMadeAKeyframe
   std::istringstream csv(test::readFile(csv_path));
   std::string line;
   ASSERT_TRUE(std::getline(csv, line));
-  EXPECT_EQ(line, "frame,t,state,keyframe,features_ms,tracking_ms,optimization_ms,place_memory_ms,total_ms");
+  EXPECT_EQ(line,
+            "frame,dataset_frame,t,state,keyframe,features_ms,tracking_ms,optimization_ms,place_memory_ms,total_ms");
   const Trajectory trajectory = readTumTrajectory(dir_->file("times.tum"));
   std::size_t rows = 0;
   long keyframes = 0;
@@ -165,15 +167,16 @@ TEST_F(RunLayouts, FrameTimesListEveryFrameWithItsStateAndWhetherItMadeAKeyframe
     std::istringstream row(line);
     std::vector<std::string> f;
     for (std::string field; std::getline(row, field, ',');) f.push_back(field);
-    ASSERT_EQ(f.size(), 9u) << line;
-    EXPECT_EQ(std::stoul(f[0]), 10 + rows) << line;
+    ASSERT_EQ(f.size(), 10u) << line;
+    EXPECT_EQ(std::stoul(f[0]), rows) << line;       // the run's count, as the stats file's state changes
+    EXPECT_EQ(std::stoul(f[1]), 10 + rows) << line;  // the dataset's index
     ASSERT_LT(rows, trajectory.size());
-    EXPECT_NEAR(std::stod(f[1]), toSeconds(trajectory[rows].t), 1e-6) << line;
-    EXPECT_EQ(f[2], "tracking") << line;  // a stereo pair tracks from its first frame
-    keyframes += std::stol(f[3]);
-    for (int stage = 4; stage < 8; ++stage) {
+    EXPECT_NEAR(std::stod(f[2]), toSeconds(trajectory[rows].t), 1e-6) << line;
+    EXPECT_EQ(f[3], "tracking") << line;  // a stereo pair tracks from its first frame
+    keyframes += std::stol(f[4]);
+    for (int stage = 5; stage < 9; ++stage) {
       EXPECT_GE(std::stod(f[stage]), 0.0) << line;
-      EXPECT_LE(std::stod(f[stage]), std::stod(f[8]) + 1e-3) << line << ": a stage longer than the frame";
+      EXPECT_LE(std::stod(f[stage]), std::stod(f[9]) + 1e-3) << line << ": a stage longer than the frame";
     }
     ++rows;
   }

@@ -80,12 +80,14 @@ Summary summarize(std::vector<double> v) {
 }  // namespace
 
 void RunReport::writeFrameTimes(const std::string& path, std::span<const std::size_t> dataset_index) const {
-  std::string csv = "frame,t,state,keyframe,features_ms,tracking_ms,optimization_ms,place_memory_ms,total_ms\n";
+  // frame: the run's own count, as in the stats file's state changes; dataset_frame: the dataset's index.
+  std::string csv =
+      "frame,dataset_frame,t,state,keyframe,features_ms,tracking_ms,optimization_ms,place_memory_ms,total_ms\n";
   char line[256];
   for (std::size_t i = 0; i < frames_.size() && i < dataset_index.size(); ++i) {
     const FrameRecord& r = frames_[i];
-    std::snprintf(line, sizeof(line), "%zu,%.6f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f\n", dataset_index[i], toSeconds(r.t),
-                  trackingStateName(r.pose.state), r.pose.is_keyframe ? 1 : 0, r.timing.features_ms,
+    std::snprintf(line, sizeof(line), "%zu,%zu,%.6f,%s,%d,%.3f,%.3f,%.3f,%.3f,%.3f\n", i, dataset_index[i],
+                  toSeconds(r.t), trackingStateName(r.pose.state), r.pose.is_keyframe ? 1 : 0, r.timing.features_ms,
                   r.timing.tracking_ms, r.timing.optimization_ms, r.timing.places_ms, r.timing.total_ms);
     csv += line;
   }

@@ -54,9 +54,9 @@ class RunReport {
 
   void writeStats(const std::string& path, const SlamPipeline& pipeline, const std::string& dataset, int cameras,
                   double wall_seconds) const;
-  // One CSV line per frame given to the SLAM (`dataset_index[i]` is the dataset's index of the i-th): its time, the
-  // tracking state, whether it made a keyframe, and each stage's time. A percentile of the stats file is a few
-  // frames: this says which ones, and what they were doing.
+  // One CSV line per frame given to the SLAM (`dataset_index[i]` is the dataset's index of the i-th): its number in
+  // the run and in the dataset, its time, the tracking state, whether it made a keyframe, and each stage's time. A
+  // percentile of the stats file is a few frames: this says which ones, and what they were doing.
   void writeFrameTimes(const std::string& path, std::span<const std::size_t> dataset_index) const;
 
  private:

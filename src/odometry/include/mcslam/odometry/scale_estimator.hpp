@@ -80,9 +80,10 @@ class ScaleEstimator {
     Vec2 uv;
     double inv_sigma;
   };
-  class Problem;                                              // the Levenberg-Marquardt problem of refine()
-  bool selectWindow(const Map& map, ScaleEstimate& out);      // keyframes: kf_T_, oldest_, out's window fields
-  void collectLandmarks(const Map& map, const Vec3& center);  // lm_p_, lm_first_, obs_, np_
+  class Problem;                                          // the Levenberg-Marquardt problem of refine()
+  bool selectWindow(const Map& map, ScaleEstimate& out);  // keyframes: kf_T_, oldest_, out's window fields
+  // eligible_, lm_p_, lm_first_, obs_, np_; false when the map holds more eligible landmarks than it was sized for.
+  bool collectLandmarks(const Map& map, const Vec3& center);
   // Appends the first `eligible` landmarks of eligible_ with their window observations: every stride-th of them
   // (the profile's share), or the others.
   void appendLandmarks(const Map& map, const Vec3& center, int eligible, int stride, bool profile_share);
