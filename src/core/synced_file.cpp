@@ -1,6 +1,7 @@
 #include "mcslam/core/synced_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -30,6 +31,22 @@ bool writeAll(int fd, std::string_view bytes) {
   return true;
 }
 
+// A path that names a device, a pipe or a socket (/dev/stdout, a FIFO a consumer reads) is written to as it is: a
+// rename would replace the node with a regular file, and such a target has no previous content to keep.
+bool isSpecialFile(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+}
+
+bool writeSpecialFile(const std::string& path, std::string_view bytes, std::string* error) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return fail(error, "cannot open", path);
+  const bool written = writeAll(fd, bytes);
+  if (!written) fail(error, "cannot write", path);
+  ::close(fd);
+  return written;
+}
+
 }  // namespace
 
 SyncedFileTarget::SyncedFileTarget(const std::string& file) : path(file), tmp(file + ".tmp") {
@@ -42,6 +59,7 @@ bool writeFileSynced(const std::string& path, std::string_view bytes, std::strin
 }
 
 bool writeFileSynced(const SyncedFileTarget& target, std::string_view bytes, std::string* error) {
+  if (isSpecialFile(target.path)) return writeSpecialFile(target.path, bytes, error);
   const int fd = ::open(target.tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return fail(error, "cannot create", target.tmp);
   const char* failed_step = nullptr;

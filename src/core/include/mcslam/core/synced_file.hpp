@@ -2,6 +2,7 @@
 // Writing a file so that it is on disk afterwards, whole or not at all: the bytes go to "<path>.tmp", which is
 // fsynced and renamed over <path>, then the folder is fsynced. A crash or power cut mid-write leaves the previous
 // <path> as it was. For the files a robot relies on after a restart (refined extrinsics, the map, the vocabulary).
+// A <path> that is a device, a pipe or a socket (/dev/stdout, a FIFO) is written to directly and left in place.
 #include <string>
 #include <string_view>
 
