@@ -306,6 +306,7 @@ void writeKalibrRig(const Rig& rig, const std::string& path) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw InputError(path + ": cannot write file");
   out << formatKalibrRig(rig);
+  out.flush();  // a full disk shows only when the buffer goes out
   if (!out) throw InputError(path + ": write failed");
 }
 

@@ -39,6 +39,7 @@ void AslDatasetWriter::close() {
     const fs::path path = fs::path(dir_) / ("cam" + std::to_string(c)) / "data.csv";
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out << csv_rows_[c];
+    out.flush();  // a full disk shows only when the buffer goes out
     if (!out) throw InputError(path.string() + ": write failed");
   }
   closed_ = true;

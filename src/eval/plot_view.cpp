@@ -77,6 +77,7 @@ void writePng(const std::string& path, const cv::Mat& img) {
   if (!cv::imencode(".png", img, png)) throw InputError(path + ": cannot encode the plot as PNG");
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+  out.flush();  // a full disk shows only when the buffer goes out
   if (!out) throw InputError(path + ": cannot write the plot");
 }
 

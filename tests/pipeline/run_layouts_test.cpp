@@ -184,3 +184,15 @@ TEST_F(RunLayouts, FrameTimesListEveryFrameWithItsStateAndWhetherItMadeAKeyframe
   EXPECT_EQ(keyframes, jsonInt(test::readFile(stats_path), "keyframes"));
   EXPECT_GT(keyframes, 1);
 }
+
+// An output that cannot be written (a full disk: /dev/full) fails the run and names the file, whichever output it
+// is; before, the stats and the extrinsics were lost with exit code 0.
+TEST_F(RunLayouts, AnOutputThatCannotBeWrittenFailsTheRunAndIsNamed) {
+  const std::string run =
+      bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --quiet --frames 5 --out " + dir_->file("full.tum");
+  for (const char* option : {"--stats", "--extrinsics", "--keyframes", "--frame-times"}) {
+    std::string out;
+    EXPECT_EQ(test::runCommand(run + " " + option + " /dev/full", &out), 2) << option << ": " << out;
+    EXPECT_NE(out.find("/dev/full"), std::string::npos) << option << ": " << out;
+  }
+}

@@ -84,6 +84,8 @@ void evaluate(const EvaluateArgs& a) {
       for (const PrPoint& p : precisionRecall(r, norm))
         out << (norm ? "normalized," : "raw,") << p.threshold << ',' << p.precision << ',' << p.recall << ','
             << p.accepted << ',' << p.correct << '\n';
+    out.flush();
+    if (!out) throw InputError(a.csv + ": cannot write the curve");
   }
 }
 

@@ -208,6 +208,8 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   }
   j.endObject();
   j.endObject();
+  out.flush();  // a full disk shows only when the buffer goes out
+  if (!out) throw InputError(path + ": cannot write stats file (write failed)");
 }
 
 }  // namespace mcslam::run
