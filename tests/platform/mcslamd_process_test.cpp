@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -32,6 +33,7 @@
 
 #include "daemon/supervisor.hpp"
 #include "daemon_fixture.hpp"
+#include "emulation.hpp"
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/dataset/trajectory.hpp"
 #include "mcslam/eval/trajectory_metrics.hpp"
@@ -474,7 +476,10 @@ TEST(McslamdProcess, RealtimeCpusKeepsEveryThreadOnThem) {
           << log;
     } else {
       EXPECT_NE(log.find("realtime: every thread on CPUs 0"), std::string::npos) << log;
-      for (const std::string& list : lists) EXPECT_EQ(list, expected);
+      // Under qemu-user one thread is the emulator's own (its RCU thread), which the daemon does not pin.
+      const long pinned = std::count(lists.begin(), lists.end(), expected);
+      EXPECT_GE(pinned, static_cast<long>(lists.size()) - (test::underEmulator() ? 1 : 0))
+          << "threads on other CPUs than " << expected;
     }
     ::kill(pid, SIGTERM);
     EXPECT_EQ(waitExit(pid, 20), 0) << log;

@@ -1,5 +1,5 @@
 #pragma once
-// Running the built mcslam-sim (path from CMake) and reading what it wrote.
+// Running the built mcslam-sim (through the emulator in a cross build, test::binPath) and reading what it wrote.
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -13,7 +13,7 @@ namespace mcslam::sim::testing {
 // Runs mcslam-sim with `args` (in folder `cwd` when given); returns its exit code, stdout+stderr in *output.
 inline int runSim(const std::string& args, std::string* output = nullptr, const std::string& cwd = "") {
   const std::string cd = cwd.empty() ? "" : "cd '" + cwd + "' && ";
-  return test::runCommand(cd + std::string(MCSLAM_SIM_EXE) + " " + args, output);
+  return test::runCommand(cd + test::binPath("mcslam-sim") + " " + args, output);
 }
 
 // Every file under dir (relative path -> bytes).
