@@ -263,7 +263,10 @@ void Tracker::startFrom(const Map& map, int slot, uint64_t frame_index) {
   last_keyframe_pose_ = T_w_last_;
   last_keyframe_tracked_ = countKeyframeLandmarks(map, slot);
   last_tracked_count_ = 0;
-  last_coarse_inliers_ = 0;
+  // The frame the map starts on saw every landmark of its keyframe: the next one, tracked with no motion model
+  // yet, must find a fair share of them before its first attempt is trusted (after a relocalization in a turn,
+  // the stale prediction finds a chance consensus of repeated texture).
+  last_coarse_inliers_ = last_keyframe_tracked_;
   const Keyframe& kf = map.keyframe(slot);
   for (int c = 0; c < kf.features.cameras(); ++c) {
     for (int k = 0; k < kf.features.sets[c].count; ++k) {

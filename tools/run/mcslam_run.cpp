@@ -4,13 +4,18 @@
 
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <exception>
 #include <future>
+#include <string_view>
+#include <system_error>
 #include <thread>
+#include <vector>
 
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/alloc_counter.hpp"
@@ -33,7 +38,7 @@ struct RunOptions {
   bool quiet = false, print_config = false, overlap = true;
   std::string log_level = "info";
   std::size_t max_frames = 0;
-  std::string black_text, skip_text;  // fault injection: frame ranges "A-B"
+  std::string black_text, skip_text;  // fault injection: frame ranges "A-B,C,..."
   bool no_loop_closure = false;
   bool live = false;
   std::size_t first_frame = 0;
@@ -41,28 +46,46 @@ struct RunOptions {
   bool localize = false;
 };
 
-// A range of frames "A-B" (both included) or "A"; empty text: none. Throws InputError naming the option.
-struct FrameRange {
-  std::size_t first = 1, last = 0;  // empty
-  bool contains(std::size_t i) const { return i >= first && i <= last; }
-};
-
-FrameRange parseFrameRange(const std::string& option, const std::string& text) {
-  FrameRange r;
-  if (text.empty()) return r;
-  unsigned long long a = 0, b = 0;
-  char dash = 0;
-  char extra = 0;
-  const int n = std::sscanf(text.c_str(), "%llu%c%llu%c", &a, &dash, &b, &extra);
-  if (n == 1) {
-    b = a;
-  } else if (n != 3 || dash != '-' || b < a) {
-    throw InputError(option + " '" + text + "': expected frames A-B with A <= B (or one frame A)");
+// Frame ranges "A-B" (both included) or "A", separated by commas; empty text: none. Throws InputError naming the
+// option.
+class FrameRanges {
+ public:
+  FrameRanges() = default;
+  FrameRanges(const std::string& option, const std::string& text) {
+    if (text.empty()) return;
+    for (std::size_t begin = 0;;) {
+      const std::size_t comma = text.find(',', begin);
+      ranges_.push_back(parseOne(option, text, std::string_view(text).substr(begin, comma - begin)));
+      if (comma == std::string::npos) break;
+      begin = comma + 1;
+    }
   }
-  r.first = static_cast<std::size_t>(a);
-  r.last = static_cast<std::size_t>(b);
-  return r;
-}
+  bool contains(std::size_t i) const {
+    return std::any_of(ranges_.begin(), ranges_.end(), [i](const Range& r) { return i >= r.first && i <= r.last; });
+  }
+
+ private:
+  struct Range {
+    std::size_t first = 0, last = 0;
+  };
+  static Range parseOne(const std::string& option, const std::string& text, std::string_view range) {
+    Range r;
+    const char* end = range.data() + range.size();
+    std::from_chars_result at = std::from_chars(range.data(), end, r.first);
+    bool ok = at.ec == std::errc() && at.ptr != range.data();
+    r.last = r.first;
+    if (ok && at.ptr != end && *at.ptr == '-') {
+      const char* second = at.ptr + 1;
+      at = std::from_chars(second, end, r.last);
+      ok = at.ec == std::errc() && at.ptr != second;
+    }
+    if (!ok || at.ptr != end || r.last < r.first)
+      throw InputError(option + " '" + text + "': '" + std::string(range) +
+                       "' is not a frame range: expected A-B with A <= B, or one frame A; ranges separated by commas");
+    return r;
+  }
+  std::vector<Range> ranges_;
+};
 
 void addOptions(CLI::App& app, RunOptions& o) {
   app.add_option(
@@ -97,10 +120,11 @@ void addOptions(CLI::App& app, RunOptions& o) {
                "Take the loop closer's results as mcslamd does, the first frame they are ready, instead of waiting "
                "for them at fixed frames: runs no longer repeat exactly");
   app.add_option("--black", o.black_text,
-                 "Fault injection: every camera's image of frames A-B (dataset indices) is black, as if the rig were "
-                 "covered");
+                 "Fault injection: every camera's image of frames A-B (dataset indices; several ranges: A-B,C-D) is "
+                 "black, as if the rig were covered");
   app.add_option("--skip", o.skip_text,
-                 "Fault injection: frames A-B are never given to the SLAM (a kidnap: the rig moved unseen)");
+                 "Fault injection: frames A-B (several ranges: A-B,C-D) are never given to the SLAM (a kidnap: the rig "
+                 "moved unseen; frames a camera dropped)");
   app.add_option("--log-level", o.log_level,
                  "Log of the pipeline's events (debug: also each scale estimate of a rig "
                  "without overlap; trace: also every frame's tracking attempts, inliers, "
@@ -126,7 +150,7 @@ YAML::Node slamSection(const std::string& path) {
 class FramePrefetch {
  public:
   // Runs the dataset's frames `order[0], order[1], ...`; those in `black` become black.
-  FramePrefetch(const Dataset& ds, const std::vector<std::size_t>& order, FrameRange black)
+  FramePrefetch(const Dataset& ds, const std::vector<std::size_t>& order, FrameRanges black)
       : ds_(ds), order_(order), frames_(order.size()), black_(black) {
     if (frames_ > 0) next_ = std::async(std::launch::async, load, std::cref(ds_), order_[0], black_);
   }
@@ -141,7 +165,7 @@ class FramePrefetch {
   }
 
  private:
-  static DatasetFrame load(const Dataset& ds, std::size_t i, FrameRange black) {
+  static DatasetFrame load(const Dataset& ds, std::size_t i, FrameRanges black) {
     DatasetFrame f;
     f.load(ds, i);
     if (black.contains(i)) f.blacken();
@@ -150,7 +174,7 @@ class FramePrefetch {
   const Dataset& ds_;
   const std::vector<std::size_t>& order_;
   std::size_t frames_;
-  FrameRange black_;
+  FrameRanges black_;
   std::future<DatasetFrame> next_;
 };
 
@@ -206,7 +230,7 @@ struct FrameTag {
 // Runs the first `frames` frames through the pipeline's stages (StageRunner): the front-end of frame i+1 on a
 // thread of its own while frame i is tracked on this one, or, without `overlap`, one after the other on this
 // thread. The stages share no state, so the output is the same either way. Returns the wall time in seconds.
-double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<std::size_t>& order, FrameRange black,
+double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<std::size_t>& order, FrameRanges black,
                  bool overlap, run::RunReport& report, Console& console) {
   const std::size_t frames = order.size();
   StageRunner<FrameTag> runner(pipeline);
@@ -318,8 +342,8 @@ int runDataset(const RunOptions& o) {
                      " frames");
   const std::size_t available = ds.size() - o.first_frame;
   const std::size_t frames = o.first_frame + (o.max_frames > 0 ? std::min(o.max_frames, available) : available);
-  const FrameRange black = parseFrameRange("--black", o.black_text);
-  const FrameRange skip = parseFrameRange("--skip", o.skip_text);
+  const FrameRanges black("--black", o.black_text);
+  const FrameRanges skip("--skip", o.skip_text);
   std::vector<std::size_t> order;
   for (std::size_t i = o.first_frame; i < frames; ++i)
     if (!skip.contains(i)) order.push_back(i);
