@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <utility>
@@ -288,7 +289,14 @@ int runDaemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> proces
       "memory {:.1f} / {:.1f} ms",
       ms(s.front_end_time.p50_ns), ms(s.front_end_time.p99_ns), ms(s.odometry_time.p50_ns), ms(s.odometry_time.p99_ns),
       ms(s.place_memory_time.p50_ns), ms(s.place_memory_time.p99_ns));
-  if (!clean) spdlog::error("the pipeline did not finish its frame within the grace period");
+  if (!clean) {
+    // A thread is still inside the pipeline, and may never return: nothing it uses may be destroyed. The
+    // trajectory of what was published is synced and the last periodic map save stands: the process ends here.
+    spdlog::error("the pipeline did not finish its frame within the grace period: exiting with code 1 at once");
+    spdlog::default_logger()->flush();
+    std::fflush(nullptr);
+    std::_Exit(1);
+  }
   if (s.shm_replacements > 0)
     spdlog::warn("publish.shm: segments made anew after a truncation by another process: {}", s.shm_replacements);
   if (s.trajectory_errors > 0)

@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -220,6 +221,48 @@ TEST_F(DaemonTest, SlowProcessingDropsTheOldestRigFramesAndNeverStallsTheReplay)
   EXPECT_GT(s.rig_drops, 0u);
   EXPECT_EQ(s.processed + s.rig_drops, s.rig_frames);
   EXPECT_EQ(s.published, s.processed);
+}
+
+// A pipeline whose frame outlasts the stop's grace period (slow, as under an emulator, or hung): stop() leaves its
+// thread behind and says so, and the daemon is not destroyed under that thread: the pipeline is released only once
+// its frame is done.
+namespace {
+class SlowToStopProcessor : public FrameProcessor {
+ public:
+  struct Flags {
+    std::atomic<bool> hold{true};  // a frame waits while set
+    std::atomic<bool> inside{false};
+    std::atomic<bool> destroyed_inside{false};
+  };
+  explicit SlowToStopProcessor(Flags& flags) : flags_(flags) {}
+  ~SlowToStopProcessor() override { flags_.destroyed_inside = flags_.inside.load(); }
+  void process(const RigFrameView& f, PoseEstimate& out) override {
+    flags_.inside = true;
+    while (flags_.hold) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the rest of the frame
+    out = PoseEstimate{};
+    out.t = f.t;
+    out.sequence = f.sequence;
+    flags_.inside = false;
+  }
+
+ private:
+  Flags& flags_;
+};
+}  // namespace
+
+TEST_F(DaemonTest, APipelineStillInsideItsFrameAfterTheGracePeriodIsReleasedOnlyOnceItIsDone) {
+  const std::string data = test::writeSmallDataset(dir_.file("data"), 1, 5);
+  const DaemonConfig c = config(data, "    at_end: idle\n");
+  SlowToStopProcessor::Flags flags;
+  auto d = std::make_unique<Daemon>(c, std::make_unique<SlowToStopProcessor>(flags));
+  d->start();
+  ASSERT_TRUE(waitFor([&] { return flags.inside.load(); }));
+  EXPECT_FALSE(d->stop(/*processing_grace_ns=*/10000000));  // the frame holds: left behind
+  flags.hold = false;
+  d.reset();
+  EXPECT_FALSE(flags.inside.load());
+  EXPECT_FALSE(flags.destroyed_inside.load()) << "the pipeline was destroyed inside its frame";
 }
 
 TEST_F(DaemonTest, TheNewestFrameSurvivesDropsAndPublishedFramesStayInOrder) {

@@ -9,7 +9,9 @@
 
 namespace mcslam::platform {
 
-// Returns the process exit code: 0 after a clean stop, 1 when the pipeline did not stop in time.
+// Returns the process exit code: 0 after a clean stop, 1 after a clean stop that lost trajectory writes. When the
+// pipeline did not finish its frame within the grace period, ends the process at once with code 1 (std::_Exit):
+// its thread cannot be joined, and what it uses must not be destroyed under it.
 // Throws InputError when start-up fails (before any thread starts). `processor`: the pipeline the configuration
 // describes when null (tests give their own).
 int runDaemon(const DaemonConfig& config, std::unique_ptr<FrameProcessor> processor = nullptr);
