@@ -185,6 +185,30 @@ TEST_F(RunLayouts, FrameTimesListEveryFrameWithItsStateAndWhetherItMadeAKeyframe
   EXPECT_GT(keyframes, 1);
 }
 
+// --skip takes several ranges (a kidnap, then frames a camera dropped right after it): those frames are never given
+// to the SLAM; a range that is not one is named, and nothing runs.
+TEST_F(RunLayouts, FramesSkippedInSeveralRangesAreNeverGivenAndABadRangeIsNamed) {
+  const std::string csv_path = dir_->file("skip.csv");
+  const std::string run = bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --quiet --frames 30 --out " +
+                          dir_->file("skip.tum") + " --frame-times " + csv_path;
+  std::string out;
+  ASSERT_EQ(test::runCommand(run + " --skip 3-5,9,20-21", &out), 0) << out;
+  std::istringstream csv(test::readFile(csv_path));
+  std::string line;
+  std::getline(csv, line);  // header
+  std::vector<unsigned long> given;
+  while (std::getline(csv, line)) given.push_back(std::stoul(line.substr(line.find(',') + 1)));
+  std::vector<unsigned long> expected;
+  for (unsigned long i = 0; i < 30; ++i)
+    if (!(i >= 3 && i <= 5) && i != 9 && !(i >= 20 && i <= 21)) expected.push_back(i);
+  EXPECT_EQ(given, expected);
+  for (const char* bad : {"3-5,,9", "7-", "-7", "9-3", "3-5,"}) {
+    EXPECT_EQ(test::runCommand(run + " --skip '" + bad + "'", &out), 2) << bad << ": " << out;
+    EXPECT_NE(out.find("--skip '" + std::string(bad) + "'"), std::string::npos) << out;
+    EXPECT_NE(out.find("is not a frame range"), std::string::npos) << out;
+  }
+}
+
 // An output that cannot be written (a full disk: /dev/full) fails the run and names the file, whichever output it
 // is; before, the stats and the extrinsics were lost with exit code 0.
 TEST_F(RunLayouts, AnOutputThatCannotBeWrittenFailsTheRunAndIsNamed) {
