@@ -152,6 +152,7 @@ void AravisSource::start(const SourceLinks& links) {
   warm_up_ = links.warm_up;
   stop_ = false;
   for (auto& cam : cameras_) {
+    if (!cam->camera) open(*cam);  // started again after a stop
     GError* err = nullptr;
     arv_camera_start_acquisition(cam->camera, &err);
     warnIf(err, cam->key, "start acquisition");
@@ -165,6 +166,10 @@ void AravisSource::stop() {
   stop_ = true;
   for (auto& cam : cameras_)
     if (cam->thread.joinable()) cam->thread.join();
+  // Released at once, not with the object: a GigE camera keeps its control privilege until it is closed, and a
+  // daemon that ends its process without destroying its objects (a pipeline stuck at the stop) must leave it free
+  // for the daemon systemd starts next.
+  for (auto& cam : cameras_) close(*cam);
 }
 
 bool AravisSource::fire(uint64_t) {

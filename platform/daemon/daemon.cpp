@@ -62,7 +62,7 @@ Daemon::~Daemon() {
   stop();
   // A frame that outlasted stop()'s grace period is still inside the pipeline, on threads that use this object's
   // members: they are released only once it is done. (mcslamd does not get here then: runDaemon ends the process.)
-  if (!started_ || processing_.finished()) return;
+  if (!processing_.leftBehind() || processing_.finished()) return;
   spdlog::warn("daemon: waiting for the pipeline to finish its frame before releasing it");
   while (!processing_.finished()) {
     timespec ts{0, 5 * kMs};

@@ -31,10 +31,19 @@ void ProcessingStage::start() {
     done_.store(true, std::memory_order_release);
   });
   if (runner_.canOverlap()) {
-    features_thread_ = std::thread([this] {
-      setUpThread("mcslam-features", "features");
-      featuresLoop();
-    });
+    features_done_.store(false, std::memory_order_release);
+    try {
+      features_thread_ = std::thread([this] {
+        setUpThread("mcslam-features", "features");
+        featuresLoop();
+        features_done_.store(true, std::memory_order_release);  // after close(): done with the runner
+      });
+    } catch (...) {  // no features thread: the tracking thread would wait for its frames for ever
+      features_done_.store(true, std::memory_order_release);
+      runner_.close();
+      processing_thread_.join();
+      throw;
+    }
   }
 }
 
@@ -50,6 +59,7 @@ void ProcessingStage::join() {
 }
 
 void ProcessingStage::detach() {
+  left_behind_ = processing_thread_.joinable() || features_thread_.joinable();
   if (processing_thread_.joinable()) processing_thread_.detach();
   if (features_thread_.joinable()) features_thread_.detach();
 }

@@ -33,10 +33,15 @@ class ProcessingStage {
   void start();
   // Asks the threads to end once the rig ring is empty and every prepared frame is finished.
   void requestStop();
-  bool finished() const { return done_.load(std::memory_order_acquire); }
+  // Every thread it started has left the processor (and its stage runner) for good.
+  bool finished() const {
+    return done_.load(std::memory_order_acquire) && features_done_.load(std::memory_order_acquire);
+  }
   // After requestStop(): join() when finished(), else detach() (a thread stuck inside the processor is left behind).
   void join();
   void detach();
+  // detach() left a thread behind: whoever owns what it uses must wait for finished() before releasing it.
+  bool leftBehind() const { return left_behind_; }
 
   uint64_t processed() const { return processed_.load(std::memory_order_relaxed); }
   uint64_t poseDrops() const { return pose_drops_.load(std::memory_order_relaxed); }
@@ -82,6 +87,8 @@ class ProcessingStage {
   std::vector<ImageView> views_;  // onto the images of the rig frame being prepared
   std::thread features_thread_, processing_thread_;
   std::atomic<bool> stop_{false}, done_{false};
+  std::atomic<bool> features_done_{true};  // false while a features thread runs
+  bool left_behind_ = false;
   std::atomic<uint64_t> taken_{0}, processed_{0}, pose_drops_{0};
   std::atomic<uint8_t> tracking_{0};
   std::atomic<bool> unscaled_{false};
