@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
+#include <limits>
 
 #include "daemon/source_factory.hpp"
 #include "mcslam/calib/calibration_io.hpp"
@@ -64,10 +65,7 @@ Daemon::~Daemon() {
   // members: they are released only once it is done. (mcslamd does not get here then: runDaemon ends the process.)
   if (!processing_.leftBehind() || processing_.finished()) return;
   spdlog::warn("daemon: waiting for the pipeline to finish its frame before releasing it");
-  while (!processing_.finished()) {
-    timespec ts{0, 5 * kMs};
-    clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
-  }
+  processing_.waitFinished(std::numeric_limits<int64_t>::max());
 }
 
 void Daemon::start() {
@@ -88,12 +86,7 @@ bool Daemon::stop(int64_t grace_ns) {
   source_->stop();
   assembly_.stop();
   processing_.requestStop();
-  const int64_t deadline = monotonicNowNs() + grace_ns;
-  while (!processing_.finished() && monotonicNowNs() < deadline) {
-    timespec ts{0, 5 * kMs};
-    clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
-  }
-  const bool processing_finished = processing_.finished();
+  const bool processing_finished = processing_.waitFinished(monotonicNowNs() + grace_ns);
   if (processing_finished)
     processing_.join();
   else

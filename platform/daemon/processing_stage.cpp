@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <time.h>
+
 #include "mcslam/core/time.hpp"
 #include "realtime/scheduling.hpp"
 
@@ -56,6 +58,14 @@ void ProcessingStage::requestStop() {
 void ProcessingStage::join() {
   if (processing_thread_.joinable()) processing_thread_.join();
   if (features_thread_.joinable()) features_thread_.join();
+}
+
+bool ProcessingStage::waitFinished(int64_t deadline_ns) const {
+  while (!finished() && monotonicNowNs() < deadline_ns) {
+    timespec ts{0, 5000000};
+    clock_nanosleep(CLOCK_MONOTONIC, 0, &ts, nullptr);
+  }
+  return finished();
 }
 
 void ProcessingStage::detach() {

@@ -50,7 +50,6 @@ struct RunOptions {
 // option.
 class FrameRanges {
  public:
-  FrameRanges() = default;
   FrameRanges(const std::string& option, const std::string& text) {
     if (text.empty()) return;
     for (std::size_t begin = 0;;) {
@@ -150,9 +149,9 @@ YAML::Node slamSection(const std::string& path) {
 class FramePrefetch {
  public:
   // Runs the dataset's frames `order[0], order[1], ...`; those in `black` become black.
-  FramePrefetch(const Dataset& ds, const std::vector<std::size_t>& order, FrameRanges black)
+  FramePrefetch(const Dataset& ds, const std::vector<std::size_t>& order, const FrameRanges& black)
       : ds_(ds), order_(order), frames_(order.size()), black_(black) {
-    if (frames_ > 0) next_ = std::async(std::launch::async, load, std::cref(ds_), order_[0], black_);
+    if (frames_ > 0) next_ = std::async(std::launch::async, load, std::cref(ds_), order_[0], std::cref(black_));
   }
   ~FramePrefetch() {
     if (next_.valid()) next_.wait();
@@ -160,12 +159,12 @@ class FramePrefetch {
   // Frame i (called for i = 0, 1, ... in turn); starts decoding frame i + 1.
   DatasetFrame take(std::size_t i) {
     DatasetFrame f = next_.get();
-    if (i + 1 < frames_) next_ = std::async(std::launch::async, load, std::cref(ds_), order_[i + 1], black_);
+    if (i + 1 < frames_) next_ = std::async(std::launch::async, load, std::cref(ds_), order_[i + 1], std::cref(black_));
     return f;
   }
 
  private:
-  static DatasetFrame load(const Dataset& ds, std::size_t i, FrameRanges black) {
+  static DatasetFrame load(const Dataset& ds, std::size_t i, const FrameRanges& black) {
     DatasetFrame f;
     f.load(ds, i);
     if (black.contains(i)) f.blacken();
@@ -174,7 +173,7 @@ class FramePrefetch {
   const Dataset& ds_;
   const std::vector<std::size_t>& order_;
   std::size_t frames_;
-  FrameRanges black_;
+  const FrameRanges& black_;
   std::future<DatasetFrame> next_;
 };
 
@@ -230,8 +229,8 @@ struct FrameTag {
 // Runs the first `frames` frames through the pipeline's stages (StageRunner): the front-end of frame i+1 on a
 // thread of its own while frame i is tracked on this one, or, without `overlap`, one after the other on this
 // thread. The stages share no state, so the output is the same either way. Returns the wall time in seconds.
-double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<std::size_t>& order, FrameRanges black,
-                 bool overlap, run::RunReport& report, Console& console) {
+double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<std::size_t>& order,
+                 const FrameRanges& black, bool overlap, run::RunReport& report, Console& console) {
   const std::size_t frames = order.size();
   StageRunner<FrameTag> runner(pipeline);
   FramePrefetch prefetch(ds, order, black);

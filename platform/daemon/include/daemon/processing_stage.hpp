@@ -37,6 +37,8 @@ class ProcessingStage {
   bool finished() const {
     return done_.load(std::memory_order_acquire) && features_done_.load(std::memory_order_acquire);
   }
+  // Polls finished() until it holds or the monotonic clock passes `deadline_ns`; returns finished().
+  bool waitFinished(int64_t deadline_ns) const;
   // After requestStop(): join() when finished(), else detach() (a thread stuck inside the processor is left behind).
   void join();
   void detach();
