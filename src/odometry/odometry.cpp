@@ -37,9 +37,11 @@ Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_featu
     extrinsic_check_ = std::make_unique<ExtrinsicCheck>(rig, options_, max_features_per_camera);
   }
   scale_ = std::make_unique<ScaleSupervisor>(rig, options_, max_features_per_camera);
+  mapping_.odometry = this;
 }
 
-Odometry::~Odometry() = default;
+// A keyframe's mapping in flight uses the map, the mapper and the triangulator.
+Odometry::~Odometry() { bridge_->wait(); }
 
 Rig Odometry::refinedRig() const { return bridge_->refinedRig(); }
 
@@ -51,6 +53,7 @@ uint64_t Odometry::backendThreadAllocations() const {
 
 void Odometry::resetMap() {
   pending_keyframe_ = -1;  // its window goes with the map
+  mapping_due_ = false;
   clearMap();
   initializer_->reset();
   if (extrinsic_check_) extrinsic_check_->reset();
@@ -58,9 +61,9 @@ void Odometry::resetMap() {
 }
 
 void Odometry::clearMap() {
+  bridge_->reset();  // first: it waits for a job that may still write the map
   map_.clear();
   mapper_->reset();
-  bridge_->reset();
 }
 
 void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
@@ -169,15 +172,12 @@ void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, co
   const int slot = mapper_->insertKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, &tracker_->matches(),
                                            T_w_b, frame_index);
   if (slot < 0) return;
-  const int created = triangulateNew(slot);
-  spdlog::trace("odometry: frame {}: keyframe, {} inliers, {} new landmarks", frame_index, inliers, created);
-  timing_.mapping_ms = msSince(map_start);
-  const auto be_start = Clock::now();
-  if (bridge_->beginSolve(map_, slot)) {
-    pending_keyframe_ = slot;
-    pending_frames_ = 0;
+  if (mappingDeferrable()) {
+    deferMapping(slot);
+    timing_.mapping_ms = msSince(map_start);
+  } else {
+    mapNow(slot, frame_index, inliers, map_start);
   }
-  timing_.backend_ms = msSince(be_start);
   tracker_->keyframeMade(frame_index, T_w_b);
   ++stats_.keyframes;
   out.is_keyframe = true;
@@ -188,6 +188,41 @@ void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, co
   }
 }
 
+void Odometry::mapNow(int slot, uint64_t frame_index, int inliers, Clock::time_point map_start) {
+  const int created = triangulateNew(slot);
+  spdlog::trace("odometry: frame {}: keyframe, {} inliers, {} new landmarks", frame_index, inliers, created);
+  timing_.mapping_ms = msSince(map_start);
+  const auto be_start = Clock::now();
+  if (bridge_->beginSolve(map_, slot)) {
+    pending_keyframe_ = slot;
+    pending_frames_ = 0;
+  }
+  timing_.backend_ms = msSince(be_start);
+}
+
+// Where the next frame waits for this keyframe's solve anyway, and a thread can take the mapping.
+bool Odometry::mappingDeferrable() const {
+  return options_.defer_keyframe_mapping && options_.backend && options_.backend_thread && apply_after_frames_ == 1;
+}
+
+void Odometry::deferMapping(int slot) {
+  mapping_.slot = slot;
+  mapping_due_ = true;
+  pending_keyframe_ = slot;
+  pending_frames_ = 0;
+}
+
+void Odometry::startDeferredMapping() {
+  if (!mapping_due_) return;
+  mapping_due_ = false;
+  bridge_->beginSolveAfter(map_, mapping_.slot, mapping_);
+}
+
+void Odometry::KeyframeMapping::run() {
+  const int created = odometry->triangulateNew(slot);
+  spdlog::trace("odometry: keyframe {}: {} new landmarks (back-end thread)", odometry->map_.keyframe(slot).id, created);
+}
+
 int Odometry::triangulateNew(int slot) {
   const Rig& rig = bridge_->rigState().rig();
   const int created = triangulator_->triangulate(map_, rig, slot);
@@ -196,6 +231,7 @@ int Odometry::triangulateNew(int slot) {
 }
 
 void Odometry::flush() {
+  startDeferredMapping();
   if (pending_keyframe_ < 0) return;
   const int slot = pending_keyframe_;
   pending_keyframe_ = -1;

@@ -43,7 +43,7 @@ WindowBridge::WindowBridge(const Rig& calibration, const OdometryOptions& option
   if (options.backend) {
     solver_ = std::make_unique<backend::SlidingWindowSolver>(
         calibration, windowCapacity(options, cams, max_features_per_camera), solverOptions(options, monocular_));
-    solve_.solver = solver_.get();
+    solve_.bridge = this;
     solve_.iterations = options.backend_iterations;
     if (options.backend_thread) task_ = std::make_unique<BackgroundTask>();
   }
@@ -129,13 +129,43 @@ bool WindowBridge::beginSolve(Map& map, int slot) {
   if (!solver_) return false;
   finishSolve(map);  // one window at a time
   if (!feed(map, slot)) return false;
+  startSolve(map, -1, nullptr);
+  return true;
+}
+
+bool WindowBridge::beginSolveAfter(Map& map, int slot, BackgroundJob& mapping) {
+  if (!solver_ || !task_) {
+    mapping.run();
+    return beginSolve(map, slot);
+  }
+  finishSolve(map);
+  startSolve(map, slot, &mapping);
+  return true;
+}
+
+void WindowBridge::startSolve(Map& map, int slot, BackgroundJob* mapping) {
+  solve_.map = &map;
+  solve_.slot = slot;
+  solve_.mapping = mapping;
   solving_ = true;
   if (task_) {
     task_->start(solve_);
   } else {
     solve_.run();
   }
-  return true;
+}
+
+void WindowBridge::WindowSolve::run() {
+  fed = true;
+  if (slot >= 0) {
+    if (mapping) mapping->run();
+    fed = bridge->feed(*map, slot);
+  }
+  if (fed) summary = bridge->solver_->solve(iterations);
+}
+
+void WindowBridge::wait() const {
+  if (task_) task_->wait();
 }
 
 bool WindowBridge::feed(Map& map, int slot) {
@@ -192,6 +222,7 @@ bool WindowBridge::finishSolve(Map& map) {
   if (!solving_) return false;
   solving_ = false;
   if (task_) task_->collect();
+  if (!solve_.fed) return false;
   const backend::SolveSummary& summary = solve_.summary;
   ++solves_;
   removeOutliers(map);

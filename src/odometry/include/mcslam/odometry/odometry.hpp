@@ -4,11 +4,13 @@
 // rays of different cameras and times, and the sliding-window back-end. Works for one camera, for
 // overlapping and for non-overlapping rigs alike. All memory is allocated at construction.
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <span>
 #include <vector>
 
+#include "mcslam/core/background_task.hpp"
 #include "mcslam/odometry/loss_clock.hpp"
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/map_seed.hpp"
@@ -69,6 +71,12 @@ class Odometry {
   // Completes the back-end work of the last keyframe: waits for its solve, applies it, then finishKeyframe().
   // process() does it first thing; call it after the last frame, before reading the map's final keyframes.
   void flush();
+  // A keyframe of a map that applies each solve before the next frame (one camera; a rig without overlap until
+  // its scale is found) leaves its new landmarks to the back-end thread, before its solve: the next frame tracks
+  // on the same map as if they had been made at once, and the frame's own time no longer pays for them. The job
+  // writes the map, so it starts only once the frame has no more use for the map: the caller says when (the
+  // pipeline, after place memory); flush() and the next process() start it otherwise.
+  void startDeferredMapping();
 
   // The frame was lost and place memory found it at T_w_b (this odometry's frame) with the place map's points
   // matched to its keypoints: the local map starts again there, from those points and the frame's own multi-view
@@ -122,6 +130,10 @@ class Odometry {
   void noteStampNotIncreasing(const FrameFeatures& frame, uint64_t frame_index);
   // A keyframe of the tracked frame: its landmarks, new points, and its back-end solve started.
   void makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers, PoseEstimate& out);
+  // The keyframe's new points and the start of its solve, now (mapNow) or on the back-end thread later.
+  void mapNow(int slot, uint64_t frame_index, int inliers, std::chrono::steady_clock::time_point map_start);
+  void deferMapping(int slot);
+  bool mappingDeferrable() const;
   // New landmarks across time for keyframe `slot` (TemporalTriangulator); returns how many.
   int triangulateNew(int slot);
   void finishKeyframe(int slot);
@@ -134,6 +146,13 @@ class Odometry {
   // At a settled keyframe of a map started up to scale: the map, the window and the motion model take the unit
   // the scale supervisor finds.
   void estimateScale();
+
+  // New landmarks for a keyframe, run on the back-end thread before its solve (startDeferredMapping()).
+  struct KeyframeMapping final : BackgroundJob {
+    void run() override;
+    Odometry* odometry = nullptr;
+    int slot = -1;
+  };
 
   OdometryOptions options_;
   Map map_;
@@ -150,6 +169,8 @@ class Odometry {
   int pending_keyframe_ = -1;   // keyframe whose back-end solve has not been applied yet
   int pending_frames_ = 0;      // frames begun since that solve started
   int apply_after_frames_ = 1;  // of this map (OdometryOptions::backend_apply_after_frames where it applies)
+  KeyframeMapping mapping_;
+  bool mapping_due_ = false;  // mapping_ is set up for pending_keyframe_ and waits for startDeferredMapping()
   int lost_frames_ = 0;
   LossClock loss_clock_;
   std::array<int32_t, 4> settled_{};

@@ -43,6 +43,12 @@ class WindowBridge {
   bool beginSolve(Map& map, int slot);
   bool finishSolve(Map& map);
   bool solving() const { return solving_; }
+  // beginSolve() after `mapping` (new landmarks for keyframe `slot`), all three on the back-end thread when there is
+  // one: the map and whatever `mapping` writes are then the thread's until finishSolve(), which returns false
+  // as well when the keyframe could not enter the window.
+  bool beginSolveAfter(Map& map, int slot, BackgroundJob& mapping);
+  // Blocks until the job on the back-end thread, if any, is done (without applying it).
+  void wait() const;
 
   // Landmark `lm` leaves the window (before the map erases it).
   void removeLandmark(Map& map, int lm);
@@ -71,11 +77,17 @@ class WindowBridge {
   int keyframeSlotOfId(const Map& map, int64_t id) const;
 
   struct WindowSolve final : BackgroundJob {
-    void run() override { summary = solver->solve(iterations); }
-    backend::SlidingWindowSolver* solver = nullptr;
+    void run() override;
+    WindowBridge* bridge = nullptr;
+    // With a keyframe to feed (slot >= 0), the mapping that must precede its entry, then the entry, then the solve.
+    BackgroundJob* mapping = nullptr;
+    Map* map = nullptr;
+    int slot = -1;
+    bool fed = true;  // false: the keyframe could not enter the window, and nothing was solved
     int iterations = 0;
     backend::SolveSummary summary;
   };
+  void startSolve(Map& map, int slot, BackgroundJob* mapping);
 
   RigState rig_state_;                        // with refinement on, its extrinsics follow the estimates
   Rig calibration_;                           // the window's prior, also for a new window after a reset
