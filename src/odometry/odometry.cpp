@@ -174,6 +174,8 @@ void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, co
   if (slot < 0) return;
   if (mappingDeferrable()) {
     deferMapping(slot);
+    spdlog::trace("odometry: frame {}: keyframe, {} inliers, new landmarks on the back-end thread", frame_index,
+                  inliers);
     timing_.mapping_ms = msSince(map_start);
   } else {
     mapNow(slot, frame_index, inliers, map_start);

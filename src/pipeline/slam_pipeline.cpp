@@ -68,7 +68,7 @@ void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Times
     places_->afterOdometry(features, sequence, odometry_, out);
     timing.places_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
-  odometry_.startDeferredMapping();  // nothing reads the odometry's map in this frame any more
+  odometry_.startDeferredMapping();  // place memory is done with the frame's landmarks
   if (handover_) {
     rig_after_[frames_tracked_ % 2].follow(odometry_.rigState());  // by value, allocates nothing
     ++frames_tracked_;

@@ -139,7 +139,8 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
       const Landmark& l = local.landmark(lm);
       // Only points whose position is certain anchor a place: a multi-view point (depth to about 1%), or one the
       // back-end has seen from three keyframes; a young point triangulated across two keyframes is only as good as the
-      // mapper's acceptance bound on its depth.
+      // mapper's acceptance bound on its depth. (Odometry::startDeferredMapping relies on it: the new points of a
+      // keyframe made in this frame, seen from it and one earlier keyframe, may not exist yet.)
       if (!l.metric && local.observingKeyframes(lm) < 3) continue;
       PlacePoint p;
       p.p_k = (unit * (T_k_o * l.p_w)).cast<float>();

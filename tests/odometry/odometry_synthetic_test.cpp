@@ -31,6 +31,7 @@ struct RunResult {
   std::vector<int> keyframe_frames;                         // frames that made a keyframe (is_keyframe)
   std::vector<int> settled_frames;                          // frames in which a keyframe was settled, one per keyframe
   std::vector<int> landmarks_at_return;                     // per frame: the map's landmarks when process() returned
+  std::vector<Vec3> final_landmarks;                        // positions of the map's landmarks after the last flush
 };
 
 // Changes frame i's features before they are processed (a camera that did not deliver, say).
@@ -75,6 +76,8 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
     }
   }
   odo.flush();
+  for (int lm = 0; lm < odo.map().landmarkCapacity(); ++lm)
+    if (odo.map().landmark(lm).alive) r.final_landmarks.push_back(odo.map().landmark(lm).p_w);
   r.allocations_after_warmup += odo.backendThreadAllocations() - backend_thread_before;
   r.stats = odo.stats();
   r.ate = test::alignedRmse(seq.groundTruth(), r.estimate, sim3, &r.scale);
@@ -161,6 +164,8 @@ TEST(OdometrySynthetic, OneCamerasKeyframeMakesItsNewPointsOnTheBackEndThreadWit
     ASSERT_EQ(deferred.estimate[i].T_w_b.R, now.estimate[i].T_w_b.R) << "pose " << i;
   }
   ASSERT_EQ(deferred.keyframe_frames, now.keyframe_frames);
+  ASSERT_EQ(deferred.settled_frames, now.settled_frames);
+  ASSERT_EQ(deferred.final_landmarks, now.final_landmarks);
   ASSERT_GE(now.keyframe_frames.size(), 10u);
   int later_keyframes = 0, made_later = 0;
   for (int i = 0; i < so.frames; ++i) {

@@ -47,7 +47,8 @@ struct OdometryStats {
 // Milliseconds spent in the stages of the last processed frame.
 struct OdometryTiming {
   double tracking_ms = 0;  // pose estimation and keyframe decision
-  double mapping_ms = 0;   // keyframe insertion and new landmarks
+  double mapping_ms = 0;   // keyframe insertion and new landmarks (those made on the back-end thread: in backend_ms
+                           // of the next frame, as far as it waits for them)
   double backend_ms = 0;   // sliding-window optimization
 };
 
@@ -71,11 +72,13 @@ class Odometry {
   // Completes the back-end work of the last keyframe: waits for its solve, applies it, then finishKeyframe().
   // process() does it first thing; call it after the last frame, before reading the map's final keyframes.
   void flush();
-  // A keyframe of a map that applies each solve before the next frame (one camera; a rig without overlap until
-  // its scale is found) leaves its new landmarks to the back-end thread, before its solve: the next frame tracks
-  // on the same map as if they had been made at once, and the frame's own time no longer pays for them. The job
-  // writes the map, so it starts only once the frame has no more use for the map: the caller says when (the
-  // pipeline, after place memory); flush() and the next process() start it otherwise.
+  // A keyframe of a map that applies each solve before the next frame (one camera's maps, maps started up to
+  // scale, and any map when backend_apply_after_frames is 1) leaves its new landmarks to the back-end thread,
+  // before its solve: the next frame tracks on the same map as if they had been made at once, and the keyframe's
+  // frame no longer pays for them. The job writes the map, so it starts only once the frame has no more use for
+  // the new landmarks: the caller says when (the pipeline, after place memory); flush() and the next process()
+  // start it otherwise. From then until the next process() or flush(), map() may be read only for what the job
+  // does not write: keyframes' poses, stamps and ids.
   void startDeferredMapping();
 
   // The frame was lost and place memory found it at T_w_b (this odometry's frame) with the place map's points

@@ -90,10 +90,10 @@ struct OdometryOptions {
   // for it, but the frames between are tracked against the map before the solve; a new keyframe, a loss or a new
   // map applies it at once. A map started up to scale always uses 1.
   int backend_apply_after_frames = 3;
-  // Where a keyframe's solve is applied before the very next frame (a map started up to scale, one camera), its new
-  // points across time are made on the back-end thread, just before the solve, instead of in the keyframe's frame
-  // (Odometry::startDeferredMapping): same map for the next frame, same output. false: in the keyframe's frame, for
-  // comparisons. Set by the program, not by the configuration file.
+  // Where a keyframe's solve is applied before the very next frame (one camera, a map started up to scale, or
+  // backend_apply_after_frames 1), its new points across time are made on the back-end thread, just before the
+  // solve, instead of in the keyframe's frame (Odometry::startDeferredMapping): same map for the next frame, same
+  // output. false: in the keyframe's frame, for comparisons. Set by the program, not by the configuration file.
   bool defer_keyframe_mapping = true;
   bool refine_extrinsics = false;
   double extrinsic_sigma_translation = 0.02;  // metres

@@ -4,7 +4,8 @@
 // OdometryOptions::backend_thread) and writes the solve back (poses, positions; outliers leave the window and the
 // map; landmarks of a marginalized keyframe become frozen). The window knows keyframes and landmarks by their ids.
 // It produces the rig state (RigState): the extrinsics the window refined, the per-camera re-estimates, the scale
-// status. The map is handed in for each call; the solver and its worker are the bridge's own.
+// status. The map is handed in for each call (and kept by a solve in flight that feeds its keyframe on the back-end
+// thread: beginSolveAfter); the solver and its worker are the bridge's own.
 #include <cstdint>
 #include <memory>
 #include <vector>
