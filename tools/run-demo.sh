@@ -42,6 +42,9 @@ echo "run-demo: running mcslam-run"
 "$bin/mcslam-run" --dataset "$dataset" --out "$out/trajectory.tum" --keyframes "$out/keyframes.tum" \
   --stats "$out/stats.json" --extrinsics "$out/extrinsics.yaml"
 echo
-"$bin/mcslam-eval" ape "$dataset" "$out/trajectory.tum" --plot "$out/trajectory.png"
+align=()
+# One camera's trajectory has an arbitrary unit: compared with the truth after a similarity, not a rigid motion.
+case "$cameras" in *,*) ;; *) align=(--align sim3) ;; esac
+"$bin/mcslam-eval" ape "$dataset" "$out/trajectory.tum" "${align[@]}" --plot "$out/trajectory.png"
 echo
 echo "run-demo: trajectory $out/trajectory.tum, timing and states $out/stats.json, top view $out/trajectory.png"
