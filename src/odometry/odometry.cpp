@@ -208,7 +208,6 @@ bool Odometry::mappingDeferrable() const {
 }
 
 void Odometry::deferMapping(int slot) {
-  mapping_.slot = slot;
   mapping_due_ = true;
   pending_keyframe_ = slot;
   pending_frames_ = 0;
@@ -217,6 +216,7 @@ void Odometry::deferMapping(int slot) {
 void Odometry::startDeferredMapping() {
   if (!mapping_due_) return;
   mapping_due_ = false;
+  mapping_.slot = pending_keyframe_;
   bridge_->beginSolveAfter(map_, mapping_.slot, mapping_);
 }
 

@@ -134,11 +134,11 @@ bool WindowBridge::beginSolve(Map& map, int slot) {
 }
 
 bool WindowBridge::beginSolveAfter(Map& map, int slot, BackgroundJob& mapping) {
-  if (!solver_ || !task_) {
+  if (!solver_) {
     mapping.run();
-    return beginSolve(map, slot);
+    return false;
   }
-  finishSolve(map);
+  finishSolve(map);  // one window at a time
   startSolve(map, slot, &mapping);
   return true;
 }

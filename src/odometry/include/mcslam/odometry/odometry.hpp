@@ -173,7 +173,7 @@ class Odometry {
   int pending_frames_ = 0;      // frames begun since that solve started
   int apply_after_frames_ = 1;  // of this map (OdometryOptions::backend_apply_after_frames where it applies)
   KeyframeMapping mapping_;
-  bool mapping_due_ = false;  // mapping_ is set up for pending_keyframe_ and waits for startDeferredMapping()
+  bool mapping_due_ = false;  // pending_keyframe_'s new landmarks wait for startDeferredMapping()
   int lost_frames_ = 0;
   LossClock loss_clock_;
   std::array<int32_t, 4> settled_{};

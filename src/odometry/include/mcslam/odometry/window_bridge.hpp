@@ -44,9 +44,9 @@ class WindowBridge {
   bool beginSolve(Map& map, int slot);
   bool finishSolve(Map& map);
   bool solving() const { return solving_; }
-  // beginSolve() after `mapping` (new landmarks for keyframe `slot`), all three on the back-end thread when there is
-  // one: the map and whatever `mapping` writes are then the thread's until finishSolve(), which returns false
-  // as well when the keyframe could not enter the window.
+  // beginSolve() after `mapping` (new landmarks for keyframe `slot`), all three in the solve's job (on the back-end
+  // thread when there is one): the map and whatever `mapping` writes are then the job's until finishSolve(), which
+  // returns false as well when the keyframe could not enter the window.
   bool beginSolveAfter(Map& map, int slot, BackgroundJob& mapping);
   // Blocks until the job on the back-end thread, if any, is done (without applying it).
   void wait() const;
