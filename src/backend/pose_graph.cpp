@@ -75,11 +75,11 @@ class PoseGraphT<Pose>::Problem final : public LeastSquaresProblem {
       const Pose& T_a = graph_.pose(a);
       const Pose& T_b = graph_.pose(b);
       const Tangent r = edgeError(graph_.edge_inverse_measurement_[se], T_a, T_b);
-      const Tangent& w = graph_.edge_weight_[se];
-      const Tangent wr = w.cwiseProduct(r);
+      const Jacobian& W = graph_.edge_weight_[se];
+      const Tangent wr = W * r;
       cost_ += 0.5 * wr.squaredNorm();
       if (va < 0 && vb < 0) continue;
-      const Jacobian Jb = w.asDiagonal() * rightJacobianInverse<Pose>(r);
+      const Jacobian Jb = W * rightJacobianInverse<Pose>(r);
       const Jacobian Ja = -Jb * (T_b.inverse() * T_a).adjoint();
       if (va >= 0) addBlock(va, Ja, wr);
       if (vb >= 0) addBlock(vb, Jb, wr);
@@ -149,7 +149,7 @@ class PoseGraphT<Pose>::Problem final : public LeastSquaresProblem {
       const auto se = static_cast<std::size_t>(e);
       const Tangent r =
           edgeError(graph_.edge_inverse_measurement_[se], trialPose(graph_.edge_a_[se]), trialPose(graph_.edge_b_[se]));
-      cost += 0.5 * graph_.edge_weight_[se].cwiseProduct(r).squaredNorm();
+      cost += 0.5 * (graph_.edge_weight_[se] * r).squaredNorm();
     }
     return std::isfinite(cost);
   }
@@ -215,12 +215,17 @@ int PoseGraphT<Pose>::addNode(const Pose& T_w_n, bool fixed) {
 
 template <class Pose>
 bool PoseGraphT<Pose>::addEdge(int a, int b, const Pose& T_a_b, const Tangent& sigma) {
+  return addEdge(a, b, T_a_b, Jacobian(sigma.cwiseInverse().asDiagonal()));
+}
+
+template <class Pose>
+bool PoseGraphT<Pose>::addEdge(int a, int b, const Pose& T_a_b, const Jacobian& sqrt_information) {
   if (edges_ == maxEdges() || a < 0 || b < 0 || a >= nodes_ || b >= nodes_) return false;
   const auto e = static_cast<std::size_t>(edges_++);
   edge_a_[e] = a;
   edge_b_[e] = b;
   edge_inverse_measurement_[e] = T_a_b.inverse();
-  edge_weight_[e] = sigma.cwiseInverse();
+  edge_weight_[e] = sqrt_information;
   return true;
 }
 
@@ -232,7 +237,7 @@ void PoseGraphT<Pose>::setFixed(int n, bool fixed) {
 template <class Pose>
 typename PoseGraphT<Pose>::Tangent PoseGraphT<Pose>::residual(int e) const {
   const auto se = static_cast<std::size_t>(e);
-  return edge_weight_[se].cwiseProduct(edgeError(edge_inverse_measurement_[se], pose(edge_a_[se]), pose(edge_b_[se])));
+  return edge_weight_[se] * edgeError(edge_inverse_measurement_[se], pose(edge_a_[se]), pose(edge_b_[se]));
 }
 
 template <class Pose>

@@ -47,6 +47,8 @@ Rig Odometry::refinedRig() const { return bridge_->refinedRig(); }
 
 const RigState& Odometry::rigState() const { return bridge_->rigState(); }
 
+double Odometry::unitSigma() const { return scale_->unitSigma(); }
+
 uint64_t Odometry::backendThreadAllocations() const {
   return bridge_->backendThreadAllocations() + scale_->threadAllocations();
 }

@@ -69,6 +69,11 @@ void ScaleSupervisor::start(bool unscaled) {
   if (filter_) filter_->reset();
 }
 
+double ScaleSupervisor::unitSigma() const {
+  if (!unscaled_start_ || !estimator_) return 0;
+  return std::clamp(filter_->sigma(), options_.scale_drift_per_keyframe, 1.0);
+}
+
 double ScaleSupervisor::windowTurn(const Map& map) {
   const int oldest = map.oldestWindowKeyframe();
   double turn = 0;

@@ -21,6 +21,24 @@ Vec6 odometrySigma(const SE3& T_a_b) {
   return s;
 }
 
+// The odometry's relative pose as a square-root information, with its length `unit_sigma` (relative) less certain
+// than its direction: tracked in a map whose unit was still being found, or drifts, it knows where it went better
+// than how far. The residual's translation is in b's frame, where the motion's direction is R_ab^T t_ab.
+Mat6 odometrySqrtInformation(const SE3& T_a_b, double unit_sigma) {
+  const Vec6 sigma = odometrySigma(T_a_b);
+  Mat6 W = Mat6::Zero();
+  W.diagonal() = sigma.cwiseInverse();
+  const double d = T_a_b.t.norm();
+  if (unit_sigma > 0 && d > 0) {
+    const Vec3 along = T_a_b.R.transpose() * T_a_b.t / d;
+    const Mat3 P = along * along.transpose();
+    const double sigma_across = sigma[0];  // the same in every direction
+    const double sigma_along = std::hypot(sigma_across, unit_sigma * d);
+    W.topLeftCorner<3, 3>() = (Mat3::Identity() - P) / sigma_across + P / sigma_along;
+  }
+  return W;
+}
+
 // A loop's scale is measured from hundreds of point depths; no better than this, whatever their spread says.
 constexpr double kLoopLogScaleSigmaFloor = 0.005;
 
@@ -39,7 +57,7 @@ struct Edges<SE3> {
   static SE3 node(const SE3& T_w_k) { return T_w_k; }
   static void odometry(backend::PoseGraph& g, int a, int b, const PlaceKeyframe& ka, const PlaceKeyframe& kb) {
     const SE3 T_a_b = ka.T_o_k.inverse() * kb.T_o_k;
-    g.addEdge(a, b, T_a_b, odometrySigma(T_a_b));
+    g.addEdge(a, b, T_a_b, odometrySqrtInformation(T_a_b, kb.unit_sigma));
   }
   static void loop(backend::PoseGraph& g, int a, int b, const LoopEdge& e, const PlaceKeyframe&, const PlaceKeyframe&) {
     g.addEdge(a, b, e.T_a_b, e.sigma);

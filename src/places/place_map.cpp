@@ -195,13 +195,13 @@ constexpr std::size_t kPoseBytes = 12 * sizeof(double);
 constexpr std::size_t kPointBytes =
     3 * sizeof(float) + sizeof(int32_t) + sizeof(int16_t) + sizeof(int8_t) + sizeof(int64_t) + sizeof(Descriptor);
 constexpr std::size_t kKeyframeBytes = sizeof(int64_t) + sizeof(int32_t) + sizeof(int64_t) + sizeof(uint64_t) +
-                                       2 * kPoseBytes + sizeof(double) + 2 * sizeof(int32_t) + sizeof(uint32_t);
+                                       2 * kPoseBytes + 2 * sizeof(double) + 2 * sizeof(int32_t) + sizeof(uint32_t);
 constexpr std::size_t kSegmentBytes = kPoseBytes + sizeof(double) + 1;
 
 }  // namespace
 
-std::size_t PlaceMap::keyframeFileBytes(bool with_scales) {
-  return with_scales ? kKeyframeBytes : kKeyframeBytes - sizeof(double);
+std::size_t PlaceMap::keyframeFileBytes(MapFileFields fields) {
+  return kKeyframeBytes - (fields.scales ? 0 : sizeof(double)) - (fields.unit_sigmas ? 0 : sizeof(double));
 }
 std::size_t PlaceMap::pointFileBytes() { return kPointBytes; }
 
@@ -235,6 +235,7 @@ void PlaceMap::write(ByteWriter& out) const {
     putPose(out, k.T_w_k);
     putPose(out, k.T_o_k);
     out.put<double>(k.unit);
+    out.put<double>(k.unit_sigma);
     out.put<int32_t>(linked(k.previous));
     out.put<int32_t>(linked(k.next));
     out.put<uint32_t>(static_cast<uint32_t>(k.point_count));
@@ -257,9 +258,15 @@ double takeScale(ByteReader& in, const char* what) {
   return s;
 }
 
+double takeUnitSigma(ByteReader& in) {
+  const auto s = in.take<double>("a keyframe's unit sigma");
+  if (!(s >= 0) || !std::isfinite(s)) in.fail("a keyframe's unit sigma is " + std::to_string(s) + ", not a sigma");
+  return s;
+}
+
 }  // namespace
 
-void PlaceMap::read(ByteReader& in, int cameras, bool with_scales) {
+void PlaceMap::read(ByteReader& in, int cameras, MapFileFields fields) {
   clear();
   next_id_ = in.take<int64_t>("the next keyframe id");
   const auto segments = in.take<uint32_t>("the segment count");
@@ -269,7 +276,7 @@ void PlaceMap::read(ByteReader& in, int cameras, bool with_scales) {
   segment_count_ = static_cast<int>(segments);
   for (int s = 0; s < segment_count_; ++s) {
     segment_T_w_o_[static_cast<std::size_t>(s)] = takePose(in, "a segment's pose");
-    segment_scale_[static_cast<std::size_t>(s)] = with_scales ? takeScale(in, "a segment's scale") : 1.0;
+    segment_scale_[static_cast<std::size_t>(s)] = fields.scales ? takeScale(in, "a segment's scale") : 1.0;
     segment_placed_[static_cast<std::size_t>(s)] = in.take<uint8_t>("a segment's placement") != 0 ? 1 : 0;
   }
   const auto count = in.take<uint32_t>("the keyframe count");
@@ -285,7 +292,8 @@ void PlaceMap::read(ByteReader& in, int cameras, bool with_scales) {
     k.frame_index = in.take<uint64_t>("a keyframe's frame");
     k.T_w_k = takePose(in, "a keyframe's world pose");
     k.T_o_k = takePose(in, "a keyframe's odometry pose");
-    k.unit = with_scales ? takeScale(in, "a keyframe's unit") : 1.0;
+    k.unit = fields.scales ? takeScale(in, "a keyframe's unit") : 1.0;
+    k.unit_sigma = fields.unit_sigmas ? takeUnitSigma(in) : 0.0;
     k.previous = in.take<int32_t>("a keyframe's predecessor");
     k.next = in.take<int32_t>("a keyframe's successor");
     const auto points = in.take<uint32_t>("a keyframe's point count");

@@ -127,6 +127,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
     ++stats_.keyframes_dropped;
     return;
   }
+  map_.setUnitSigma(slot, odometry.unitSigma());
   const SE3 T_k_o = kf.T_w_b.inverse();
   const int levels_up = words_.directLevelsUp();
   std::fill(own_points_.begin(), own_points_.end(), Eigen::Vector3f::Constant(std::nanf("")));
@@ -386,8 +387,8 @@ void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool 
       h.vocabulary_fingerprint != vocabulary_fingerprint_)
     in.fail("the map was made with another vocabulary (fingerprint " + std::to_string(h.vocabulary_fingerprint) +
             ", this one's " + std::to_string(vocabulary_fingerprint_) + "): its places cannot be recognized");
-  const bool with_scales = h.version >= 2;
-  map_.read(in, static_cast<int>(cameras_.size()), with_scales);
+  const MapFileFields fields = MapFileFields::ofVersion(h.version);
+  map_.read(in, static_cast<int>(cameras_.size()), fields);
   database_.clear();
   int64_t last_landmark = -1;
   for (int slot = 0; slot < map_.size(); ++slot) {
@@ -396,7 +397,7 @@ void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool 
     database_.insert(slot, file_words_);
     for (const PlacePoint& p : map_.points(slot)) last_landmark = std::max(last_landmark, p.landmark_id);
   }
-  loop_closer_.read(in, map_.segments(), with_scales);
+  loop_closer_.read(in, map_.segments(), fields.scales);
   if (in.remaining() != 0) in.fail(std::to_string(in.remaining()) + " bytes of trailing data");
   loaded_ = true;
   std::fill(anchored_.begin(), anchored_.end(), 0);

@@ -1,5 +1,6 @@
 // The pose graph: a consistent graph stays as it is; a drifting loop closed by one edge is pulled back onto the
-// truth; the optimum is a stationary point of the true cost (no small move of any free pose lowers it); fixed
+// truth; the optimum is a stationary point of the true cost (no small move of any free pose lowers it), with
+// uncertainties per direction or correlated between directions; fixed
 // nodes do not move; optimizing allocates nothing, also after the graph grew. The Sim(3) graph takes out a drift of
 // scale, which no SE(3) graph can.
 #include <gtest/gtest.h>
@@ -96,13 +97,32 @@ TEST(PoseGraph, ALoopEdgeTakesTheDriftOut) {
   EXPECT_LT(s.final_cost, 0.01 * s.initial_cost);
 }
 
-TEST(PoseGraph, TheOptimumIsAStationaryPointOfTheCost) {
+// An uncertainty with correlated directions, as the loop closer gives an odometry whose length is less certain than
+// its direction: W = (diag(1/sigma) + strictly upper random terms), fixed by the seed.
+Mat6 correlatedSqrtInformation(const Vec6& sigma, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  Mat6 W = Mat6::Zero();
+  for (int r = 0; r < 6; ++r) {
+    W(r, r) = 1 / sigma[r];
+    for (int c = r + 1; c < 6; ++c) W(r, c) = u(rng) / std::sqrt(sigma[r] * sigma[c]);
+  }
+  return W;
+}
+
+void expectTheOptimumIsStationary(bool correlated) {
   const int n = 60;
   const auto truth = circle(n);
   const Odometry odo = drifting(truth, 0.01, 0.01, 5);
   PoseGraph g(64, 256);
   for (int i = 0; i < n; ++i) g.addNode(odo.chained[static_cast<std::size_t>(i)], i == 0);
-  for (int i = 0; i + 1 < n; ++i) g.addEdge(i, i + 1, odo.relative[static_cast<std::size_t>(i)], sigmas(0.05, 0.01));
+  std::mt19937_64 rng(11);
+  for (int i = 0; i + 1 < n; ++i) {
+    const SE3& T = odo.relative[static_cast<std::size_t>(i)];
+    if (correlated)
+      g.addEdge(i, i + 1, T, correlatedSqrtInformation(sigmas(0.05, 0.01), rng));
+    else
+      g.addEdge(i, i + 1, T, sigmas(0.05, 0.01));
+  }
   for (int i = 0; i + 10 < n; i += 7)  // loop edges everywhere, with noise: no graph without tension
     g.addEdge(i + 10, i,
               truth[static_cast<std::size_t>(i + 10)].inverse() * truth[static_cast<std::size_t>(i)] *
@@ -128,6 +148,12 @@ TEST(PoseGraph, TheOptimumIsAStationaryPointOfTheCost) {
       EXPECT_LT(std::abs(gradient), 1e-3 * (1 + optimum)) << "node " << node << " direction " << k;
     }
   }
+}
+
+TEST(PoseGraph, TheOptimumIsAStationaryPointOfTheCost) { expectTheOptimumIsStationary(/*correlated=*/false); }
+
+TEST(PoseGraph, TheOptimumIsAStationaryPointOfTheCostAlsoWithCorrelatedUncertainties) {
+  expectTheOptimumIsStationary(/*correlated=*/true);
 }
 
 TEST(PoseGraph, OptimizingAllocatesNothingAlsoAfterTheGraphGrew) {

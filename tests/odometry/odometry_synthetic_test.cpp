@@ -25,6 +25,7 @@ struct RunResult {
   double ate = 0;
   double scale = 1;
   uint64_t allocations_after_warmup = 0;
+  int first_tracked = -1;                                   // first tracked frame
   int first_metric = -1;                                    // first tracked frame whose pose says it is metric
   int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
   std::vector<float> quality;                               // per frame (0 when not tracked)
@@ -32,6 +33,7 @@ struct RunResult {
   std::vector<int> settled_frames;                          // frames in which a keyframe was settled, one per keyframe
   std::vector<int> landmarks_at_return;                     // per frame: the map's landmarks when process() returned
   std::vector<Vec3> final_landmarks;                        // positions of the map's landmarks after the last flush
+  std::vector<double> unit_sigma;                           // per frame: Odometry::unitSigma() when process() returned
 };
 
 // Changes frame i's features before they are processed (a camera that did not deliver, say).
@@ -47,6 +49,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
   RunResult r;
   r.quality.assign(static_cast<std::size_t>(seq.frames()), 0.0f);
   r.landmarks_at_return.reserve(static_cast<std::size_t>(seq.frames()));  // filled inside the allocation count
+  r.unit_sigma.reserve(static_cast<std::size_t>(seq.frames()));
   uint64_t backend_thread_before = 0;  // allocations of the back-end thread before the warm-up ended
   for (int i = 0; i < seq.frames(); ++i) {
     if (i == so.warmup_frames) backend_thread_before = odo.backendThreadAllocations();
@@ -57,6 +60,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
     alloc::ThreadScope scope;
     odo.process(f, i, pose);
     r.landmarks_at_return.push_back(odo.map().liveLandmarks());
+    r.unit_sigma.push_back(odo.unitSigma());
     odo.startDeferredMapping();  // as the pipeline does, once place memory is done with the frame
     if (i >= so.warmup_frames) {
       r.allocations_after_warmup += scope.count();
@@ -68,6 +72,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
     if (pose.valid && pose.state == TrackingState::Tracking) {
       r.quality[static_cast<std::size_t>(i)] = pose.quality;
       r.estimate.push_back({pose.t, pose.T_w_b});
+      if (r.first_tracked < 0) r.first_tracked = i;
       if (r.first_metric < 0 && pose.metric) r.first_metric = i;
       if (r.first_metric >= 0) {
         ++r.tracked_after_metric;
@@ -217,6 +222,7 @@ TEST(OdometrySynthetic, Stereo) {
   EXPECT_LT(r.ate, 0.08);
   EXPECT_EQ(r.tracked_after_metric, static_cast<int>(r.estimate.size())) << "a metric start: every pose in metres";
   EXPECT_EQ(r.unscaled_after_metric, 0);
+  EXPECT_EQ(*std::max_element(r.unit_sigma.begin(), r.unit_sigma.end()), 0.0) << "its unit is the metre throughout";
   if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }
@@ -240,6 +246,17 @@ static void expectMetricScaleOnceConverged(const test::SyntheticSequenceOptions&
   // Converging took the bound; afterwards the filter lets the unit drift between turns (its sigma grows on a
   // straight, shrinks in a turn), but it stays well inside the 5%.
   EXPECT_LE(r.stats.combined_scale_sigma, 0.05 / 2.0);
+  // What the loop closer is told of the unit (Odometry::unitSigma): unknown until the first estimate, then the
+  // combined estimate's sigma, never below the drift it is taken to have per keyframe.
+  const OdometryOptions defaults;
+  const auto converged = static_cast<std::size_t>(r.stats.scale_converged_frame);
+  EXPECT_EQ(r.unit_sigma[static_cast<std::size_t>(r.first_tracked)], 1.0);
+  for (std::size_t i = static_cast<std::size_t>(r.first_tracked); i < r.unit_sigma.size(); ++i) {
+    ASSERT_GE(r.unit_sigma[i], defaults.scale_drift_per_keyframe) << "frame " << i;
+    if (i >= converged) {
+      ASSERT_LE(r.unit_sigma[i], 0.05) << "frame " << i;
+    }
+  }
   test::SyntheticSequence seq(test::nonOverlappingRig3(), so);
   // 'Before': the first half of the frames up to convergence (a confident correction may come before it).
   const Timestamp t_converged = seq.truth(static_cast<int>(r.stats.scale_converged_frame)).t;
@@ -309,6 +326,7 @@ TEST(OdometrySynthetic, OneCameraUpToScale) {
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_GT(r.stats.tracking, 150u);
   EXPECT_EQ(r.first_metric, -1) << "one camera's poses never are in metres";
+  EXPECT_EQ(*std::max_element(r.unit_sigma.begin(), r.unit_sigma.end()), 0.0) << "its graph carries the unit itself";
   if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }

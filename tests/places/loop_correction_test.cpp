@@ -3,6 +3,8 @@
 // segment moved during the solve makes the solution stale; without waiting, the solution is taken once ready; a
 // correction allocates nothing after the first, on either thread. In a map whose unit drifts (one camera), the
 // Sim(3) correction takes the drift of the unit out too: keyframes, their points and the segment's odometry unit.
+// In a metric map whose unit was uncertain for a stretch (a rig without overlap before its scale converged), the
+// rigid correction stretches that stretch instead of bending the rest.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -232,6 +234,63 @@ TEST(LoopCorrection, ASecondSolveDoesNotApplyASimilarityLoopAgain) {
   ASSERT_EQ(correction.take(d.map, true), LoopCorrection::Outcome::Applied);
   EXPECT_NEAR(d.map.segmentScale(d.segment) / scale, 1.0, 0.01);
   EXPECT_LT((d.map.keyframe(39).T_w_k.t - newest.t).norm(), 0.05);
+}
+
+// A circle of `n` keyframes whose odometry measured keyframes 1 to `short_end` at 0.7 of their length (the unit a rig
+// without overlap had before it converged), the rest right. Each keyframe looks 60 degrees off its direction of
+// travel, turning by a further degree per keyframe, so that the length's direction is the same in no two frames.
+struct ShortStretch {
+  PlaceMap map{64, 1};
+  int32_t segment = -1;
+  std::vector<SE3> truth;
+  LoopEdge loop;
+};
+
+ShortStretch shortStretch(int n, int short_end, double unit_sigma) {
+  ShortStretch d;
+  d.segment = d.map.createSegment(SE3());
+  SE3 chained;
+  for (int i = 0; i < n; ++i) {
+    SE3 T = poseAt(2 * M_PI * i / n, 10);
+    T.R = T.R * so3Exp(Vec3(0, 0, (60.0 + i) * M_PI / 180));
+    d.truth.push_back(T);
+    if (i == 0) chained = T;
+    const bool short_step = i >= 1 && i <= short_end;
+    if (i > 0) {
+      SE3 step = d.truth[i - 1].inverse() * d.truth[i];
+      if (short_step) step.t *= 0.7;
+      chained = chained * step;
+    }
+    const int slot = d.map.createKeyframe(d.segment, i, static_cast<uint64_t>(i), chained, chained);
+    d.map.setUnitSigma(slot, short_step ? unit_sigma : 0.0);
+  }
+  d.loop = {d.map.keyframe(0).id, d.map.keyframe(n - 1).id, d.truth[0].inverse() * d.truth[n - 1],
+            Vec6::Constant(0.01)};
+  return d;
+}
+
+double worstPositionError(const ShortStretch& d) {
+  double worst = 0;
+  for (int i = 0; i < static_cast<int>(d.truth.size()); ++i)
+    worst = std::max(worst, (d.map.keyframe(i).T_w_k.t - d.truth[static_cast<std::size_t>(i)].t).norm());
+  return worst;
+}
+
+TEST(LoopCorrection, AStretchWhoseUnitWasUncertainTakesTheCorrectionInItsLength) {
+  ShortStretch known = shortStretch(40, 12, 0.0), uncertain = shortStretch(40, 12, 0.5);
+  const double before = worstPositionError(uncertain);
+  LoopCorrection by_known(64, 4), by_uncertain(64, 4);
+  by_known.start(known.map, {&known.loop, 1}, kOwnRoots);
+  by_uncertain.start(uncertain.map, {&uncertain.loop, 1}, kOwnRoots);
+  ASSERT_EQ(by_known.take(known.map, true), LoopCorrection::Outcome::Applied);
+  ASSERT_EQ(by_uncertain.take(uncertain.map, true), LoopCorrection::Outcome::Applied);
+  EXPECT_GT(before, 2.0);
+  // Told nothing, the graph bends the whole circle (4.4 m off at worst); told which lengths were uncertain, it
+  // lengthens them. Not each by 1/0.7: one loop says how much longer the stretch is along two directions, and
+  // independent lengths share that unevenly (0.23 m off at worst).
+  EXPECT_GT(worstPositionError(known), 2.0);
+  EXPECT_LT(worstPositionError(uncertain), 0.1 * worstPositionError(known));
+  EXPECT_LT(worstPositionError(uncertain), 0.3);
 }
 
 }  // namespace

@@ -44,6 +44,7 @@ PlaceMap sampleMap() {
                                      poseAt(i, 0.1 * i + 0.05));
     for (int j = 0; j < i; ++j) map.addPoint(k, pointAt(10 * i + j, 100 * i + j, static_cast<int16_t>(j % 2)));
     map.finishKeyframe(k);
+    map.setUnitSigma(k, 0.1 * i);  // made while a rig without overlap was finding its unit
   }
   map.scaleKeyframe(3, 1.25);
   map.eraseKeyframe(2);
@@ -85,6 +86,7 @@ TEST(MapFile, ThePlaceMapSurvivesAWriteAndARead) {
     EXPECT_TRUE(r.T_w_k.R.isApprox(k.T_w_k.R) && r.T_w_k.t.isApprox(k.T_w_k.t));
     EXPECT_TRUE(r.T_o_k.t.isApprox(k.T_o_k.t));
     EXPECT_EQ(r.unit, k.unit);
+    EXPECT_EQ(r.unit_sigma, k.unit_sigma);
     // Neighbours are the same keyframes (by id), in other slots.
     EXPECT_EQ(r.previous < 0 ? -1 : after.keyframe(r.previous).id,
               k.previous < 0 ? -1 : before.keyframe(k.previous).id);
@@ -179,7 +181,7 @@ TEST(MapFile, TheEnvelopeRefusesForeignTruncatedCorruptAndNewerFiles) {
   EXPECT_EQ(openError(corrupt), "robot.map: checksum mismatch: the map file is corrupt");
   std::string newer = good;
   newer[8] = 9;
-  EXPECT_EQ(openError(newer), "robot.map: map file version 9, this build reads versions 1 to 2");
+  EXPECT_EQ(openError(newer), "robot.map: map file version 9, this build reads versions 1 to 3");
 }
 
 Rig isecRig(const std::vector<int>& cameras) {

@@ -1,11 +1,12 @@
 #pragma once
 // A pose graph: nodes are poses T_w_n (the place map's keyframes), edges are measured relative poses between two
-// nodes (consecutive keyframes by the odometry; a recognized place by loop closure) with a standard deviation per
-// tangent direction. optimize() moves the free nodes to agree with every edge in the least-squares sense
-// (residual log(T_ab^-1 T_a^-1 T_b), right perturbations), Levenberg-Marquardt over a sparse CHOLMOD
-// factorization. The poses are SE(3) (PoseGraph: a metric map) or Sim(3) (SimilarityPoseGraph: a map whose unit
-// drifts, whose loops measure a scale too). Capacities are fixed at construction; adding, optimizing and reading
-// allocate nothing.
+// nodes (consecutive keyframes by the odometry; a recognized place by loop closure) with its uncertainty: a standard
+// deviation per tangent direction, or a square-root information matrix when the directions are correlated (an
+// odometry whose unit is uncertain knows its direction of travel better than its length). optimize() moves the free
+// nodes to agree with every edge in the least-squares sense (residual log(T_ab^-1 T_a^-1 T_b), right perturbations),
+// Levenberg-Marquardt over a sparse CHOLMOD factorization. The poses are SE(3) (PoseGraph: a metric map) or Sim(3)
+// (SimilarityPoseGraph: a map whose unit drifts, whose loops measure a scale too). Capacities are fixed at
+// construction; adding, optimizing and reading allocate nothing.
 #include <memory>
 #include <vector>
 
@@ -30,6 +31,7 @@ template <class Pose>
 class PoseGraphT {
  public:
   using Tangent = typename Pose::Tangent;
+  using Jacobian = typename Pose::Jacobian;
 
   PoseGraphT(int max_nodes, int max_edges);
   ~PoseGraphT();
@@ -42,6 +44,8 @@ class PoseGraphT {
   // Edge measuring T_a_b = T_w_a^-1 T_w_b, with standard deviations per tangent direction ([rho (m); phi (rad)],
   // then log scale for Sim(3)). False when full.
   bool addEdge(int a, int b, const Pose& T_a_b, const Tangent& sigma);
+  // The same with a square-root information W (W^T W is the inverse covariance of the tangent residual).
+  bool addEdge(int a, int b, const Pose& T_a_b, const Jacobian& sqrt_information);
 
   int nodes() const { return nodes_; }
   int edges() const { return edges_; }
@@ -64,7 +68,7 @@ class PoseGraphT {
   std::vector<uint8_t> fixed_;
   std::vector<int32_t> edge_a_, edge_b_;
   std::vector<Pose> edge_inverse_measurement_;  // T_a_b^-1
-  std::vector<Tangent> edge_weight_;            // 1 / sigma
+  std::vector<Jacobian> edge_weight_;           // square-root information: whitened residual = W r
   int nodes_ = 0, edges_ = 0;
   std::unique_ptr<Problem> problem_;
 };

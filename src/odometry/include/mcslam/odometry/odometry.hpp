@@ -114,6 +114,9 @@ class Odometry {
   // False while a map started up to scale (rig without overlap) waits for its window to fix the scale: poses
   // until then have an arbitrary unit. True for a metric start and for one camera (whose scale never is).
   bool scaleConverged() const { return rigState().scaleConverged(); }
+  // Relative standard deviation of the map's unit now (ScaleSupervisor::unitSigma): how far the length of a motion
+  // tracked in this map can be off while its direction is not.
+  double unitSigma() const;
   // Heap allocations made so far on the back-end thread and the scale estimate's (0 when they run inline).
   uint64_t backendThreadAllocations() const;
   // Frame index of the reference frame of the last initialization when it used two frames (the frames

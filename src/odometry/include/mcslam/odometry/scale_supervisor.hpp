@@ -46,6 +46,11 @@ class ScaleSupervisor {
   // its estimate when the window turned and none is in flight.
   Rescale takeEstimate(const Map& map, const RigState& rig, uint64_t frame_index, OdometryStats& stats);
   void startEstimate(const Map& map, const RigState& rig, double rotation_travelled, uint64_t frame_index);
+  // Relative standard deviation of the map's unit as the estimates know it now: 0 for a map that started metric (its
+  // unit is the metre from the start) and for one camera (its graph carries the unit itself); the combined
+  // estimate's sigma for a map started up to scale, at least the drift it is taken to have per keyframe, and 1 (the
+  // unit unknown) before any estimate.
+  double unitSigma() const;
   // Heap allocations made on the supervisor's thread so far (0 without one).
   uint64_t threadAllocations() const { return task_ ? task_->allocations() : 0; }
 

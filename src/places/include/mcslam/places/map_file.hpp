@@ -21,8 +21,8 @@ namespace mcslam {
 
 struct MapFileHeader {
   // 2: segments' scales, keyframes' units and loops' scales (Sim(3) loop closure). Version 1 files are read as
-  // metric maps.
-  static constexpr uint32_t kVersion = 2;
+  // metric maps. 3: keyframes' unit sigmas; earlier files read as made in a known unit (MapFileFields).
+  static constexpr uint32_t kVersion = 3;
   static constexpr uint32_t kOldestVersion = 1;
   uint32_t version = kVersion;  // of the file read
   struct Camera {

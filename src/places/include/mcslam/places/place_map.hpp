@@ -43,8 +43,19 @@ struct PlaceKeyframe {
   // closures scaled it by since (1 in a metric map). The odometry's motion to the next keyframe, times this, is
   // that motion in the world's unit.
   double unit = 1.0;
+  // Relative standard deviation of the odometry's unit over the motion from the previous keyframe to this one
+  // (Odometry::unitSigma when it was made): 0 in a map that was metric from its start. The loop closer's graph lets
+  // that motion's length, not its direction, give way by this much.
+  double unit_sigma = 0;
   int32_t previous = -1, next = -1;  // neighbours in its segment (slots)
   int32_t point_count = 0;
+};
+
+// What a map file holds beyond version 1's, by its version (MapFileHeader::kVersion).
+struct MapFileFields {
+  bool scales = true;       // 2: segments' scales, keyframes' units, loops' scales (Sim(3) loop closure)
+  bool unit_sigmas = true;  // 3: keyframes' unit sigmas
+  static MapFileFields ofVersion(uint32_t version) { return {version >= 2, version >= 3}; }
 };
 
 class PlaceMap {
@@ -62,6 +73,7 @@ class PlaceMap {
   // A new keyframe at the end of `segment` (slot, or -1 when the pool is full). Its points are added with
   // addPoint() and then sorted by finishKeyframe().
   int createKeyframe(int32_t segment, Timestamp t, uint64_t frame_index, const SE3& T_w_k, const SE3& T_o_k);
+  void setUnitSigma(int slot, double sigma) { keyframes_[static_cast<std::size_t>(slot)].unit_sigma = sigma; }
   bool addPoint(int slot, const PlacePoint& point);  // false when the keyframe holds its maximum
   void finishKeyframe(int slot);
   void eraseKeyframe(int slot);  // its neighbours become each other's
@@ -122,13 +134,13 @@ class PlaceMap {
   // replaces the map by the file's, its keyframes in slots 0.. in that order; a file that does not fit the capacities,
   // or whose points name a camera beyond `cameras`, is refused (InputError from `in`).
   void write(ByteWriter& out) const;
-  // `with_scales`: the file has the segments' scales and the keyframes' units (map files before version 2 do not:
-  // their maps are metric).
-  void read(ByteReader& in, int cameras, bool with_scales = true);
+  // `fields`: what the file's version holds (a map file before version 2 has no scales: its maps are metric; before
+  // version 3 no unit sigmas: its keyframes read as made in a unit that was known).
+  void read(ByteReader& in, int cameras, MapFileFields fields = {});
   // Bytes write() needs at most for this map's capacities; bytes one keyframe (without its points) and one point
   // take in it.
   std::size_t maxWrittenBytes() const;
-  static std::size_t keyframeFileBytes(bool with_scales = true);
+  static std::size_t keyframeFileBytes(MapFileFields fields = {});
   static std::size_t pointFileBytes();
   int64_t nextId() const { return next_id_; }
 
