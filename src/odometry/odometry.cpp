@@ -272,7 +272,7 @@ void Odometry::estimateScale() {
     bridge_->rescale(map_, r.s, r.center);
     tracker_->rescale(r.s, r.center);
     if (rescale_count_ < static_cast<int>(rescales_.size()))
-      rescales_[static_cast<std::size_t>(rescale_count_++)] = {r.s, r.center};
+      rescales_[static_cast<std::size_t>(rescale_count_++)] = {r.s, r.center, r.from_frame};
     if (r.converged) bridge_->setScaleStatus(ScaleStatus::Metric);
   }
   scale_->startEstimate(map_, bridge_->rigState(), tracker_->rotationTravelled(), frame_index_);

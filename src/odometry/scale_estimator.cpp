@@ -275,6 +275,7 @@ bool ScaleEstimator::selectWindow(const Map& map, ScaleEstimate& out) {
   oldest_ = kf_slot_of_[oldest];
   out.oldest_id = map.keyframe(oldest).id;
   out.oldest_slot = oldest;
+  out.oldest_frame = map.keyframe(oldest).frame_index;
   out.newest_id = map.keyframe(newest).id;
   for (int w = 0; w < nk_; ++w) {
     kf_T_[w] = map.keyframe(kf_order_[w]).T_w_b;

@@ -153,6 +153,7 @@ ScaleSupervisor::Rescale ScaleSupervisor::takeEstimate(const Map& map, const Rig
   r.apply = true;
   r.s = std::exp(x);
   r.center = centerNow(map, e);
+  r.from_frame = scale_converged ? e.oldest_frame : 0;
   r.converged = converges;
   spdlog::debug("odometry: map rescaled by {:.4f} at frame {}", r.s, frame_index);
   filter_->applied();

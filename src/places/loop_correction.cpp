@@ -201,8 +201,12 @@ void LoopCorrection::apply(const Graph& graph, PlaceMap& map) {
     segment_delta_[static_cast<std::size_t>(s)] =
         parent >= 0 && newestNode(parent) >= 0 ? segment_delta_[static_cast<std::size_t>(parent)] : Sim3();
   }
+  // Rotations are made orthonormal again: each correction composes the segment's frame with the last one, and its
+  // newest keyframe's pose with that frame, so a rounding error of the rotation would double with every correction
+  // (after a few dozen, the published pose ran away by metres).
   for (int32_t s = 0; s < map.segments(); ++s) {
-    const Sim3 moved = segment_delta_[static_cast<std::size_t>(s)] * map.segmentSimilarity(s);
+    Sim3 moved = segment_delta_[static_cast<std::size_t>(s)] * map.segmentSimilarity(s);
+    moved.normalize();
     map.setSegmentPose(s, moved.rigid());
     map.setSegmentScale(s, moved.s);
   }
@@ -211,8 +215,9 @@ void LoopCorrection::apply(const Graph& graph, PlaceMap& map) {
     if (!k.alive) continue;
     const int node = node_of_slot_[static_cast<std::size_t>(slot)];
     const bool in_graph = k.id < graph_next_id_ && node >= 0 && id_of_node_[static_cast<std::size_t>(node)] == k.id;
-    const Sim3 moved =
+    Sim3 moved =
         in_graph ? Sim3(graph.pose(node)) : segment_delta_[static_cast<std::size_t>(k.segment)] * Sim3(k.T_w_k);
+    moved.normalize();
     map.setKeyframePose(slot, moved.rigid());
     if (moved.s != 1.0) map.scaleKeyframe(slot, moved.s);
   }

@@ -150,13 +150,14 @@ SE3 PlaceMap::segmentPoseFor(int32_t segment, const SE3& T_w_b, const SE3& T_o_b
   return (Sim3(T_w_b, segmentScale(segment)) * Sim3(T_o_b).inverse()).rigid();
 }
 
-void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center) {
+void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center, uint64_t from_frame) {
   ++reshapes_;
+  const Vec3 center_w = toWorld(segment, SE3(Mat3::Identity(), center)).t;
   for (int slot = 0; slot < capacity(); ++slot) {
     PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
-    if (!k.alive || k.segment != segment) continue;
+    if (!k.alive || k.segment != segment || k.frame_index < from_frame) continue;
     k.T_o_k.t = center + s * (k.T_o_k.t - center);
-    k.T_w_k = toWorld(segment, k.T_o_k);
+    k.T_w_k.t = center_w + s * (k.T_w_k.t - center_w);  // a loop's bending of the keyframe stays
     PlacePoint* points = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
     for (int i = 0; i < k.point_count; ++i) points[i].p_k *= static_cast<float>(s);
   }

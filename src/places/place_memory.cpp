@@ -42,7 +42,7 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   takeCorrection(options_.repeatable);
   followSegment(odometry);
   // Before the keyframes settled in this frame join: they are in the new unit already.
-  for (const Odometry::Rescale& r : odometry.rescales()) map_.rescaleSegment(segment_, r.s, r.center);
+  for (const Odometry::Rescale& r : odometry.rescales()) map_.rescaleSegment(segment_, r.s, r.center, r.from_frame);
   if (!localize_only_)
     for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
   if (out.state == TrackingState::Tracking && out.valid) {  // the odometry's path, for the drift it can have

@@ -34,6 +34,11 @@ struct RunResult {
   std::vector<int> landmarks_at_return;                     // per frame: the map's landmarks when process() returned
   std::vector<Vec3> final_landmarks;                        // positions of the map's landmarks after the last flush
   std::vector<double> unit_sigma;                           // per frame: Odometry::unitSigma() when process() returned
+  struct Rescaled {
+    int frame;
+    uint64_t from_frame;
+  };
+  std::vector<Rescaled> rescales;  // the map's new units, in order
 };
 
 // Changes frame i's features before they are processed (a camera that did not deliver, say).
@@ -50,6 +55,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
   r.quality.assign(static_cast<std::size_t>(seq.frames()), 0.0f);
   r.landmarks_at_return.reserve(static_cast<std::size_t>(seq.frames()));  // filled inside the allocation count
   r.unit_sigma.reserve(static_cast<std::size_t>(seq.frames()));
+  r.rescales.reserve(static_cast<std::size_t>(seq.frames()));
   uint64_t backend_thread_before = 0;  // allocations of the back-end thread before the warm-up ended
   for (int i = 0; i < seq.frames(); ++i) {
     if (i == so.warmup_frames) backend_thread_before = odo.backendThreadAllocations();
@@ -61,6 +67,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
     odo.process(f, i, pose);
     r.landmarks_at_return.push_back(odo.map().liveLandmarks());
     r.unit_sigma.push_back(odo.unitSigma());
+    for (const Odometry::Rescale& rescale : odo.rescales()) r.rescales.push_back({i, rescale.from_frame});
     odo.startDeferredMapping();  // as the pipeline does, once place memory is done with the frame
     if (i >= so.warmup_frames) {
       r.allocations_after_warmup += scope.count();
@@ -251,6 +258,16 @@ static void expectMetricScaleOnceConverged(const test::SyntheticSequenceOptions&
   const OdometryOptions defaults;
   const auto converged = static_cast<std::size_t>(r.stats.scale_converged_frame);
   EXPECT_EQ(r.unit_sigma[static_cast<std::size_t>(r.first_tracked)], 1.0);
+  // A new unit applies to the motion made in the old one: all of it while the unit was arbitrary, that since the
+  // estimate's window once it was known (what the place map rescales).
+  for (const RunResult::Rescaled& rescale : r.rescales) {
+    if (rescale.frame <= r.stats.scale_converged_frame) {
+      EXPECT_EQ(rescale.from_frame, 0u) << "frame " << rescale.frame;
+    } else {
+      EXPECT_GT(rescale.from_frame, 0u) << "frame " << rescale.frame;
+      EXPECT_LT(rescale.from_frame, static_cast<uint64_t>(rescale.frame)) << "frame " << rescale.frame;
+    }
+  }
   for (std::size_t i = static_cast<std::size_t>(r.first_tracked); i < r.unit_sigma.size(); ++i) {
     ASSERT_GE(r.unit_sigma[i], defaults.scale_drift_per_keyframe) << "frame " << i;
     if (i >= converged) {

@@ -1,5 +1,6 @@
 // The place map: keyframes chained per segment, points sorted by vocabulary node, slots recycled and ids not,
-// capacity honoured, nothing allocated after construction.
+// capacity honoured, nothing allocated after construction; a new unit of the odometry rescales the keyframes made in
+// the old one: all of them while the unit was arbitrary, those since the estimate's window once it was known.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -122,6 +123,54 @@ TEST(PlaceMap, TurningMakesAKeyframeNeeded) {
   PlaceMap map(8, 1);
   const std::vector<int> k = chain(map, {0, 1, 2, 3, 4}, {0, 0, 0, 90, 90});
   EXPECT_EQ(map.leastNeededKeyframe({}), k[1]);
+}
+
+// Four keyframes 2 m apart along x in a segment placed 10 m up y; the third was bent 0.5 m sideways by a loop.
+struct Straight {
+  PlaceMap map{8, 2};
+  int32_t segment = -1;
+  int slots[4] = {};
+};
+
+Straight straight() {
+  Straight d;
+  d.segment = d.map.createSegment(SE3(Mat3::Identity(), Vec3(0, 10, 0)));
+  for (int i = 0; i < 4; ++i) {
+    const SE3 T_o_k(Mat3::Identity(), Vec3(2.0 * i, 0, 0));
+    d.slots[i] =
+        d.map.createKeyframe(d.segment, i, 100 + static_cast<uint64_t>(i), d.map.toWorld(d.segment, T_o_k), T_o_k);
+    d.map.addPoint(d.slots[i], pointAt(1, i));
+    d.map.finishKeyframe(d.slots[i]);
+  }
+  d.map.setKeyframePose(d.slots[2], SE3(Mat3::Identity(), Vec3(4, 10.5, 0)));
+  return d;
+}
+
+TEST(PlaceMap, AnArbitraryUnitIsRescaledEverywhere) {
+  Straight d = straight();
+  d.map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0));  // from frame 0
+  EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_o_k.t.isApprox(Vec3(-2, 0, 0)));
+  EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_w_k.t.isApprox(Vec3(-2, 10, 0)));
+  EXPECT_TRUE(d.map.keyframe(d.slots[3]).T_w_k.t.isApprox(Vec3(10, 10, 0)));
+  EXPECT_TRUE(d.map.keyframe(d.slots[2]).T_w_k.t.isApprox(Vec3(6, 11, 0)));  // its bend scales with it
+  EXPECT_FLOAT_EQ(d.map.points(d.slots[0])[0].p_k.z(), 2.0f);
+}
+
+TEST(PlaceMap, ADriftedUnitIsRescaledFromTheEstimatesWindowOn) {
+  Straight d = straight();
+  const uint64_t reshapes = d.map.reshapes();
+  d.map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0), /*from_frame=*/101);
+  // Made before the window: as they were, so that the motion between them keeps its length.
+  EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_o_k.t.isApprox(Vec3(0, 0, 0)));
+  EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_w_k.t.isApprox(Vec3(0, 10, 0)));
+  EXPECT_FLOAT_EQ(d.map.points(d.slots[0])[0].p_k.z(), 1.0f);
+  // From the window's oldest keyframe (the center) on: rescaled about it, in either frame, the loop's bend kept.
+  EXPECT_TRUE(d.map.keyframe(d.slots[1]).T_w_k.t.isApprox(Vec3(2, 10, 0)));
+  EXPECT_TRUE(d.map.keyframe(d.slots[2]).T_o_k.t.isApprox(Vec3(6, 0, 0)));
+  EXPECT_TRUE(d.map.keyframe(d.slots[2]).T_w_k.t.isApprox(Vec3(6, 11, 0)));
+  EXPECT_TRUE(d.map.keyframe(d.slots[3]).T_w_k.t.isApprox(Vec3(10, 10, 0)));
+  EXPECT_FLOAT_EQ(d.map.points(d.slots[3])[0].p_k.z(), 2.0f);
+  EXPECT_GT(d.map.reshapes(), reshapes);  // a correction solved from the poses before is stale
 }
 
 }  // namespace

@@ -93,10 +93,12 @@ class Odometry {
   }
 
   // The map's unit changed (a rig without overlap found or followed its scale): positions p became
-  // center + s (p - center). Those of the last process(), in order; valid until the next call.
+  // center + s (p - center). Those of the last process(), in order; valid until the next call. The motion found in
+  // the wrong unit is that of the keyframes from frame `from_frame` on (ScaleSupervisor::Rescale).
   struct Rescale {
     double s = 1;
     Vec3 center = Vec3::Zero();
+    uint64_t from_frame = 0;
   };
   std::span<const Rescale> rescales() const { return {rescales_.data(), static_cast<std::size_t>(rescale_count_)}; }
 

@@ -37,6 +37,7 @@ struct ScaleEstimate {
   double relative_sigma = INFINITY;  // sigma(s) / s
   Vec3 center = Vec3::Zero();        // position of the window's oldest keyframe
   int oldest_slot = -1;              // its map slot
+  uint64_t oldest_frame = 0;         // its frame
   int keyframes = 0;
   int64_t oldest_id = -1, newest_id = -1;  // the window's keyframe ids
   int landmarks = 0;

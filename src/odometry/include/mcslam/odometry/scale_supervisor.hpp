@@ -37,6 +37,9 @@ class ScaleSupervisor {
     bool apply = false;  // multiply positions about `center` by `s`
     double s = 1;
     Vec3 center = Vec3::Zero();
+    // The motion made in the unit found wrong: since the estimate window's oldest keyframe (its frame) once the
+    // unit was known; all of it (0) while the unit was arbitrary.
+    uint64_t from_frame = 0;
     bool converged = false;  // the first rescale of a certain estimate: the map is metric from now on
   };
   // At each settled keyframe (frame `frame_index`), in this order: takeEstimate() waits for the estimate

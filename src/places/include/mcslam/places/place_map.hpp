@@ -87,9 +87,12 @@ class PlaceMap {
   void setKeyframePose(int slot, const SE3& T_w_k) { keyframes_[static_cast<std::size_t>(slot)].T_w_k = T_w_k; }
   // A Sim(3) loop correction scaled the keyframe's surroundings by `s` about its body: its unit and points follow.
   void scaleKeyframe(int slot, double s);
-  // The segment's odometry took a new unit (positions p became center + s (p - center) in its frame): its
-  // keyframes' odometry and world poses and their points follow.
-  void rescaleSegment(int32_t segment, double s, const Vec3& center);
+  // The segment's odometry took a new unit (positions p became center + s (p - center) in its frame) for the motion
+  // since frame `from_frame`: the keyframes made from then on follow (their odometry and world poses, about the
+  // center in either frame, and their points); those made before keep their poses, so that the motion between
+  // them keeps its length (the motion of a map whose unit drifted was right when it was made; a map whose unit was
+  // arbitrary rescales all of it, from frame 0).
+  void rescaleSegment(int32_t segment, double s, const Vec3& center, uint64_t from_frame = 0);
   std::span<const PlacePoint> points(int slot) const {
     return {points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_),
             static_cast<std::size_t>(keyframes_[static_cast<std::size_t>(slot)].point_count)};
