@@ -47,7 +47,10 @@ Rig Odometry::refinedRig() const { return bridge_->refinedRig(); }
 
 const RigState& Odometry::rigState() const { return bridge_->rigState(); }
 
-double Odometry::unitSigma() const { return scale_->unitSigma(); }
+double Odometry::unitSigma() const {
+  const int newest = map_.newestKeyframe();
+  return scale_->unitSigma(newest >= 0 ? map_.keyframe(newest).id : -1);
+}
 
 uint64_t Odometry::backendThreadAllocations() const {
   return bridge_->backendThreadAllocations() + scale_->threadAllocations();

@@ -63,15 +63,17 @@ void ScaleSupervisor::endEstimate() {
 
 void ScaleSupervisor::start(bool unscaled) {
   unscaled_start_ = unscaled;
+  starts_unscaled_ = starts_unscaled_ || unscaled;
   // An estimate in flight belonged to the old map: taken at the next settled keyframe and dropped, so that a new
   // map does not wait for it.
   stale_ = in_flight_;
   if (filter_) filter_->reset();
 }
 
-double ScaleSupervisor::unitSigma() const {
-  if (!unscaled_start_ || !estimator_) return 0;
-  return std::clamp(filter_->sigma(), options_.scale_drift_per_keyframe, 1.0);
+double ScaleSupervisor::unitSigma(int64_t newest_id) const {
+  if (!estimator_ || !starts_unscaled_) return 0;
+  if (!unscaled_start_) return options_.scale_drift_per_keyframe;
+  return std::clamp(filter_->sigmaAt(newest_id), options_.scale_drift_per_keyframe, 1.0);
 }
 
 double ScaleSupervisor::windowTurn(const Map& map) {

@@ -84,7 +84,11 @@ void PlaceMap::eraseKeyframe(int slot) {
   PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
   if (!k.alive) return;
   if (k.previous >= 0) keyframes_[static_cast<std::size_t>(k.previous)].next = k.next;
-  if (k.next >= 0) keyframes_[static_cast<std::size_t>(k.next)].previous = k.previous;
+  if (k.next >= 0) {
+    PlaceKeyframe& next = keyframes_[static_cast<std::size_t>(k.next)];
+    next.previous = k.previous;
+    next.unit_sigma = std::max(next.unit_sigma, k.unit_sigma);  // its motion from the previous now spans both
+  }
   int32_t& newest = newest_of_segment_[static_cast<std::size_t>(k.segment)];
   if (newest == slot) newest = k.previous;
   if (newest_ == slot) newest_ = k.previous;

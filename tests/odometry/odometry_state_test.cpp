@@ -2,6 +2,7 @@
 // tracker's per-landmark counts.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <set>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "mcslam/odometry/map.hpp"
 #include "mcslam/odometry/odometry.hpp"
 #include "mcslam/odometry/rig_state.hpp"
+#include "mcslam/odometry/scale_estimator.hpp"
 #include "mcslam/odometry/scale_supervisor.hpp"
 #include "mcslam/odometry/window_bridge.hpp"
 #include "synthetic_sequence.hpp"
@@ -164,6 +166,35 @@ TEST(ScaleSupervisor, AMetricMapIsNeverRescaled) {
   const ScaleSupervisor::Rescale r = supervisor.takeEstimate(map, state, 9, stats);
   EXPECT_FALSE(r.apply);
   EXPECT_EQ(stats.scale_estimates, 0u);
+}
+
+// What the loop closer is told of the unit: nothing uncertain for a rig whose maps start metric; for a rig that
+// started a map up to scale, unknown before any estimate; and, for a map it then started metric (from a place
+// map's points after a loss), the drift per keyframe: nothing follows that map's unit.
+TEST(ScaleSupervisor, TheUnitSigmaSaysWhatFollowsTheUnit) {
+  const Rig rig = test::nonOverlappingRig3();
+  OdometryOptions options;
+  ScaleSupervisor supervisor(rig, options, 100);
+  supervisor.start(false);
+  EXPECT_EQ(supervisor.unitSigma(5), 0.0);
+  supervisor.start(true);
+  EXPECT_EQ(supervisor.unitSigma(5), 1.0);
+  supervisor.start(false);
+  EXPECT_EQ(supervisor.unitSigma(5), options.scale_drift_per_keyframe);
+  ScaleSupervisor one_camera(test::isecRig().subset({2}), options, 100);
+  one_camera.start(true);
+  EXPECT_EQ(one_camera.unitSigma(5), 0.0);
+}
+
+// The combined estimate's sigma grows with the drift from its last window to the keyframe asked about.
+TEST(ScaleFilter, TheSigmaGrowsWithTheDriftSinceTheLastWindow) {
+  ScaleFilter filter;
+  EXPECT_EQ(filter.sigmaAt(10), INFINITY);
+  filter.setDrift(0.01);
+  ASSERT_TRUE(filter.add(0.0, 0.02, 0, 10, 0.0));
+  EXPECT_NEAR(filter.sigmaAt(10), 0.02, 1e-12);
+  EXPECT_NEAR(filter.sigmaAt(5), 0.02, 1e-12);
+  EXPECT_NEAR(filter.sigmaAt(26), std::sqrt(0.02 * 0.02 + 16 * 0.01 * 0.01), 1e-12);
 }
 
 // The window knows landmarks by their ids, not their slots: after slots were recycled (ids ahead of slots), a solve

@@ -26,7 +26,7 @@ SE3 poseAt(double angle_rad, double radius) {
 // A circle of `n` keyframes, as a drifting odometry chains them (a yaw error per step), in one segment whose
 // odometry frame is the world's; and the loop the last keyframe closes onto the first.
 struct DriftedLoop {
-  PlaceMap map{64, 1};
+  PlaceMap map{128, 1};
   int32_t segment = -1;
   std::vector<SE3> truth;
   LoopEdge loop;
@@ -301,14 +301,16 @@ double orthonormalityError(const Mat3& R) { return (R.transpose() * R - Mat3::Id
 // a few hundred keyframes, 2e-8 four corrections later, until the published pose ran away by metres.
 TEST(LoopCorrection, RotationsStayOrthonormalOverManyCorrections) {
   DriftedLoop d = driftedLoop(40);
+  ASSERT_GE(d.map.capacity(), 100);
   LoopCorrection correction(128, 4);
   SE3 T_o_newest = d.map.keyframe(39).T_o_k;
   const SE3 step(so3Exp(Vec3(0.01, 0.02, 0.3)), Vec3(0.4, 0.1, 0));
   double worst = 0;
   for (int i = 0; i < 60; ++i) {
     T_o_newest = T_o_newest * step;
-    d.map.createKeyframe(d.segment, 40 + i, 40 + static_cast<uint64_t>(i), d.map.toWorld(d.segment, T_o_newest),
-                         T_o_newest);
+    ASSERT_GE(d.map.createKeyframe(d.segment, 40 + i, 40 + static_cast<uint64_t>(i),
+                                   d.map.toWorld(d.segment, T_o_newest), T_o_newest),
+              0);
     correction.start(d.map, {&d.loop, 1}, kOwnRoots);
     ASSERT_EQ(correction.take(d.map, /*wait=*/true), LoopCorrection::Outcome::Applied);
     worst = std::max(worst, orthonormalityError(d.map.segmentPose(d.segment).R));

@@ -115,7 +115,7 @@ double mib(std::size_t bytes) { return static_cast<double>(bytes) / (1024.0 * 10
 
 void printSummary(const MapSummary& s) {
   const MapFileHeader& h = s.header;
-  std::printf("%s: mcslam map, version %u, %.2f MiB\n", s.file.c_str(), MapFileHeader::kVersion, mib(s.file_bytes));
+  std::printf("%s: mcslam map, version %u, %.2f MiB\n", s.file.c_str(), h.version, mib(s.file_bytes));
   std::printf("  cameras     %zu (%s)\n", h.cameras.size(), camerasText(h).c_str());
   std::printf("  vocabulary  %u words, fingerprint %u\n", h.vocabulary_words, h.vocabulary_fingerprint);
   std::printf("  keyframes   %d, %.1f m of path\n", s.keyframes, s.path_m);
@@ -144,7 +144,7 @@ void printSummaryJson(const MapSummary& s) {
   JsonWriter j(std::cout);
   j.beginObject();
   j.key("file").value(s.file);
-  j.key("version").value(MapFileHeader::kVersion);
+  j.key("version").value(s.header.version);
   j.key("file_bytes").value(static_cast<unsigned long long>(s.file_bytes));
   j.key("cameras").beginArray();
   for (const MapFileHeader::Camera& c : s.header.cameras) {

@@ -166,6 +166,13 @@ class ScaleFilter {
   bool add(double log_scale, double sigma, int64_t oldest_id, int64_t newest_id, double rotation);
   double correction() const { return fuse(committed_, pending_).x; }  // log of the factor the map needs
   double sigma() const { return info() > 0 ? 1.0 / std::sqrt(info()) : INFINITY; }
+  // The same with the drift since the last window added, up to keyframe `newest_id` (on a straight no window is
+  // added, and the unit drifts most there).
+  double sigmaAt(int64_t newest_id) const {
+    if (!(info() > 0)) return INFINITY;
+    const double keyframes = last_newest_ >= 0 && newest_id > last_newest_ ? double(newest_id - last_newest_) : 0.0;
+    return std::sqrt(1.0 / info() + drift_variance_ * keyframes);
+  }
   double rotationSpan() const { return last_rotation_ - first_rotation_; }
   // From now on the unit random-walks by this relative sigma per keyframe (0: it holds).
   void setDrift(double sigma_per_keyframe) { drift_variance_ = sigma_per_keyframe * sigma_per_keyframe; }

@@ -49,11 +49,12 @@ class ScaleSupervisor {
   // its estimate when the window turned and none is in flight.
   Rescale takeEstimate(const Map& map, const RigState& rig, uint64_t frame_index, OdometryStats& stats);
   void startEstimate(const Map& map, const RigState& rig, double rotation_travelled, uint64_t frame_index);
-  // Relative standard deviation of the map's unit as the estimates know it now: 0 for a map that started metric (its
-  // unit is the metre from the start) and for one camera (its graph carries the unit itself); the combined
-  // estimate's sigma for a map started up to scale, at least the drift it is taken to have per keyframe, and 1 (the
-  // unit unknown) before any estimate.
-  double unitSigma() const;
+  // Relative standard deviation of the map's unit as the estimates know it at keyframe `newest_id`: 0 for a rig
+  // whose maps start metric (cameras that overlap: the unit is the metre from the start) and for one camera (its
+  // graph carries the unit itself). For a rig without overlap: the combined estimate's sigma with the drift since,
+  // at least the drift per keyframe, and 1 (the unit unknown) before any estimate; the drift per keyframe for a map
+  // it started metric (from a place map's points after a loss), whose unit nothing follows.
+  double unitSigma(int64_t newest_id) const;
   // Heap allocations made on the supervisor's thread so far (0 without one).
   uint64_t threadAllocations() const { return task_ ? task_->allocations() : 0; }
 
@@ -70,6 +71,7 @@ class ScaleSupervisor {
   std::unique_ptr<ScaleFilter> filter_;
   std::unique_ptr<EstimateJob> job_;
   bool unscaled_start_ = false;
+  bool starts_unscaled_ = false;          // the rig has started a map up to scale: its unit drifts
   bool in_flight_ = false;                // started and not taken
   bool stale_ = false;                    // the estimate in flight belongs to a map before start()
   std::unique_ptr<BackgroundTask> task_;  // last: stops before the estimator goes; null: estimates run at once
