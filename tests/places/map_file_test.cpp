@@ -1,8 +1,10 @@
 // The map file: the place map survives a write and a read (keyframes, chains, points, ids), whatever the slots;
 // a truncated, corrupt, foreign, newer or oversized file, or one of another rig or vocabulary, is refused with an
-// error naming the file and the fault; writing into a buffer sized from the capacities allocates nothing.
+// error naming the file and the fault; a version 2 file reads as made in a known unit; writing into a buffer sized
+// from the capacities allocates nothing.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <functional>
 #include <memory>
 
@@ -56,6 +58,53 @@ std::string written(const PlaceMap& map) {
   ByteWriter w(bytes);
   map.write(w);
   return bytes;
+}
+
+// The place map's part of a version 2 file: version 3's with each keyframe's unit sigma (the last double before
+// its links and point count) taken out.
+std::string asVersion2(const std::string& v3, const PlaceMap& map) {
+  const std::size_t record = PlaceMap::keyframeFileBytes();
+  const std::size_t pose = (record - 56) / 2;  // the record's two poses; the rest is 56 bytes of ids and numbers
+  const std::size_t sigma_at = record - 12 - sizeof(double);
+  std::size_t at = sizeof(int64_t) + sizeof(uint32_t) + static_cast<std::size_t>(map.segments()) * (pose + 9);
+  std::string v2 = v3.substr(0, at + sizeof(uint32_t));
+  uint32_t keyframes = 0;
+  std::memcpy(&keyframes, v3.data() + at, sizeof(keyframes));
+  at += sizeof(uint32_t);
+  for (uint32_t k = 0; k < keyframes; ++k) {
+    uint32_t points = 0;
+    std::memcpy(&points, v3.data() + at + record - sizeof(uint32_t), sizeof(points));
+    v2 += v3.substr(at, sigma_at);
+    v2 += v3.substr(at + sigma_at + sizeof(double), 12 + points * PlaceMap::pointFileBytes());
+    at += record + points * PlaceMap::pointFileBytes();
+  }
+  EXPECT_EQ(at, v3.size());
+  return v2;
+}
+
+TEST(MapFile, AVersion2MapReadsAsMadeInAKnownUnit) {
+  const PlaceMap before = sampleMap();
+  const std::string v2 = asVersion2(written(before), before);
+  ASSERT_EQ(v2.size() + static_cast<std::size_t>(before.size()) * sizeof(double), written(before).size());
+  PlaceMap after(6, 5);
+  ByteReader in(v2, "old.map");
+  after.read(in, 2, MapFileFields::ofVersion(2));
+  EXPECT_EQ(in.remaining(), 0u);
+  ASSERT_EQ(after.size(), before.size());
+  int slot = 0;
+  for (int b = 0; b < before.capacity(); ++b) {
+    const PlaceKeyframe& k = before.keyframe(b);
+    if (!k.alive) continue;
+    const PlaceKeyframe& r = after.keyframe(slot++);
+    EXPECT_EQ(r.id, k.id);
+    EXPECT_EQ(r.unit, k.unit);
+    EXPECT_EQ(r.unit_sigma, 0.0);
+    EXPECT_EQ(r.point_count, k.point_count);
+  }
+  // Read as version 3 it is refused, not misread.
+  PlaceMap misread(6, 5);
+  ByteReader as_v3(v2, "old.map");
+  EXPECT_THROW(misread.read(as_v3, 2), InputError);
 }
 
 TEST(MapFile, ThePlaceMapSurvivesAWriteAndARead) {
