@@ -63,7 +63,7 @@ void ScaleSupervisor::endEstimate() {
 
 void ScaleSupervisor::start(bool unscaled) {
   unscaled_start_ = unscaled;
-  starts_unscaled_ = starts_unscaled_ || unscaled;
+  ever_unscaled_ = ever_unscaled_ || unscaled;
   // An estimate in flight belonged to the old map: taken at the next settled keyframe and dropped, so that a new
   // map does not wait for it.
   stale_ = in_flight_;
@@ -71,7 +71,7 @@ void ScaleSupervisor::start(bool unscaled) {
 }
 
 double ScaleSupervisor::unitSigma(int64_t newest_id) const {
-  if (!estimator_ || !starts_unscaled_) return 0;
+  if (!estimator_ || !ever_unscaled_) return 0;
   if (!unscaled_start_) return options_.scale_drift_per_keyframe;
   return std::clamp(filter_->sigmaAt(newest_id), options_.scale_drift_per_keyframe, 1.0);
 }

@@ -71,7 +71,7 @@ class ScaleSupervisor {
   std::unique_ptr<ScaleFilter> filter_;
   std::unique_ptr<EstimateJob> job_;
   bool unscaled_start_ = false;
-  bool starts_unscaled_ = false;          // the rig has started a map up to scale: its unit drifts
+  bool ever_unscaled_ = false;            // some map of this rig started up to scale: its metric maps drift too
   bool in_flight_ = false;                // started and not taken
   bool stale_ = false;                    // the estimate in flight belongs to a map before start()
   std::unique_ptr<BackgroundTask> task_;  // last: stops before the estimator goes; null: estimates run at once

@@ -44,8 +44,8 @@ struct PlaceKeyframe {
   // that motion in the world's unit.
   double unit = 1.0;
   // Relative standard deviation of the odometry's unit over the motion from the previous keyframe to this one
-  // (Odometry::unitSigma when it was made): 0 in a map that was metric from its start. The loop closer's graph lets
-  // that motion's length, not its direction, give way by this much.
+  // (Odometry::unitSigma when it was made): 0 for a rig whose maps start metric. The loop closer's graph lets that
+  // motion's length, not its direction, give way by this much.
   double unit_sigma = 0;
   int32_t previous = -1, next = -1;  // neighbours in its segment (slots)
   int32_t point_count = 0;
