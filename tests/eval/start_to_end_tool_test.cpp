@@ -1,5 +1,6 @@
 // tools/eval/start_to_end.py: the start-to-end error BENCHMARKS.md gives for loop closure, in the trajectory's own
-// frame (a whole trajectory turned and moved rigidly has none), and a clear error when no pose matches the ground truth.
+// frame (a whole trajectory turned and moved rigidly has none), and a clear error when no pose matches the ground
+// truth.
 #include <gtest/gtest.h>
 
 #include <algorithm>
