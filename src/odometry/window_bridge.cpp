@@ -87,12 +87,32 @@ void WindowBridge::rescale(Map& map, double s, const Vec3& center) {
   for (int lm = 0; lm < map.landmarkCapacity(); ++lm) {
     Landmark& l = map.landmark(lm);
     if (!l.alive) continue;
-    l.p_w = center + s * (l.p_w - center);
+    l.p_w = center + s * (l.p_w - center) - (s - 1) * leverArmOfNewestObserver(map, l);
     if (solver_ && l.in_backend) solver_->setLandmarkPosition(l.id, l.p_w);
     // ORB finds it again over distances that scale with it.
     l.min_distance *= static_cast<float>(s);
     l.max_distance *= static_cast<float>(s);
   }
+}
+
+// What was in the wrong unit is the rig's motion, not its lever arms: a landmark's depth along the ray of a camera
+// that saw it is what scales, about that camera's centre. Scaling about the body would move the point off every
+// ray by (s - 1) times the lever arm (decimetres on a rig without overlap, and the next frame's pose with it).
+// The newest observer is the camera tracking continues near; older ones differ from it only by the rig's rotation
+// since.
+Vec3 WindowBridge::leverArmOfNewestObserver(const Map& map, const Landmark& l) const {
+  int newest = -1;
+  int64_t newest_id = -1;
+  for (int o = 0; o < l.obs_count; ++o) {
+    const Keyframe& k = map.keyframe(l.obs[o].keyframe);
+    if (k.alive && k.id > newest_id) {
+      newest_id = k.id;
+      newest = o;
+    }
+  }
+  if (newest < 0) return Vec3::Zero();
+  const LandmarkObservation& o = l.obs[newest];
+  return map.keyframe(o.keyframe).T_w_b.R * rig_state_.T_b_c(o.cam).t;
 }
 
 void WindowBridge::holdScale(bool hold) {

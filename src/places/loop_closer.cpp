@@ -31,16 +31,21 @@ LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale
       segment_root_(PlaceMap::kMaxSegments),
       roots_(PlaceMap::kMaxSegments),
       correction_(options.max_keyframes, options.max_loops, similarity),
+      camera_centers_(rig.cameraCenters()),
       detect_features_(rig.size(), max_features_per_camera),
       detect_words_(rig.size(), max_features_per_camera),
       features_per_camera_(max_features_per_camera) {
-  if (similarity) {
-    const auto keypoints = static_cast<std::size_t>(rig.size()) * static_cast<std::size_t>(max_features_per_camera);
-    detect_own_points_.assign(keypoints, Eigen::Vector3f::Constant(std::nanf("")));
-    scale_scratch_.resize(keypoints);
-  }
+  const auto keypoints = static_cast<std::size_t>(rig.size()) * static_cast<std::size_t>(max_features_per_camera);
+  detect_own_points_.assign(keypoints, Eigen::Vector3f::Constant(std::nanf("")));
+  scale_scratch_.resize(keypoints);
   detection_.closer = this;
   clear();
+}
+
+void LoopCloser::setRig(const Rig& rig) {
+  verifier_.setRig(rig);
+  for (int c = 0; c < rig.size() && c < static_cast<int>(camera_centers_.size()); ++c)
+    camera_centers_[static_cast<std::size_t>(c)] = rig.T_b_c(c).t;
 }
 
 void LoopCloser::clear() {
@@ -66,12 +71,10 @@ void LoopCloser::startDetection(int slot, const FrameFeatures& features, const F
   detect_database_ = &database;
   detect_features_ = features;  // same capacities: no allocation
   detect_words_ = words;
-  if (similarity()) {
-    const std::size_t n = std::min(own_points.size(), detect_own_points_.size());
-    std::copy_n(own_points.begin(), n, detect_own_points_.begin());
-    std::fill(detect_own_points_.begin() + static_cast<std::ptrdiff_t>(n), detect_own_points_.end(),
-              Eigen::Vector3f::Constant(std::nanf("")));
-  }
+  const std::size_t n = std::min(own_points.size(), detect_own_points_.size());
+  std::copy_n(own_points.begin(), n, detect_own_points_.begin());
+  std::fill(detect_own_points_.begin() + static_cast<std::ptrdiff_t>(n), detect_own_points_.end(),
+            Eigen::Vector3f::Constant(std::nanf("")));
   detection_task_.start(detection_);
 }
 
@@ -91,7 +94,7 @@ void LoopCloser::detect() {
   }
 }
 
-bool LoopCloser::collectDetection(const PlaceMap& map, bool wait) {
+bool LoopCloser::collectDetection(PlaceMap& map, bool wait) {
   if (!detection_task_.running()) return false;
   if (!detection_task_.ready()) {
     if (!wait) return false;
@@ -101,13 +104,13 @@ bool LoopCloser::collectDetection(const PlaceMap& map, bool wait) {
   return decide(detect_slot_, found_, map);
 }
 
-bool LoopCloser::decide(int slot, const RelocalizationResult& r, const PlaceMap& map) {
+bool LoopCloser::decide(int slot, const RelocalizationResult& r, PlaceMap& map) {
   if (!r.ok) {
     pending_keyframe_ = -1;
     return false;
   }
   ++stats_.verified;
-  if (!closesALoop(map, r.keyframe, slot)) {
+  if (!closesALoop(map, r.keyframe, slot) || (!similarity() && !settlePlaceUnits(slot, map))) {
     pending_keyframe_ = -1;
     return false;
   }
@@ -168,7 +171,7 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, const PlaceMap&
 }
 
 bool LoopCloser::takeCorrection(PlaceMap& map, bool wait) {
-  const LoopCorrection::Outcome outcome = correction_.take(map, wait);
+  const LoopCorrection::Outcome outcome = correction_.take(map, wait, camera_centers_);
   if (outcome == LoopCorrection::Outcome::Stale) {
     ++stats_.restarted;
     correction_wanted_ = true;
@@ -197,6 +200,34 @@ void LoopCloser::startCorrection(const PlaceMap& map) {
   for (int32_t s = 0; s < segments; ++s) roots_[static_cast<std::size_t>(s)] = findRoot(s);
   correction_.start(map, loopEdges(), {roots_.data(), static_cast<std::size_t>(segments)});
   correction_wanted_ = false;
+}
+
+// The verification matched the points of the candidate and its neighbours, each in the unit of its own time
+// (PlaceUnit). Each of uncertain unit is measured against this keyframe's own points on its own matches; one in
+// another unit takes the unit they measured, and the loop is left for the next keyframe to measure again on them.
+// One with too few matches of its own adds too little to the pose to decide.
+bool LoopCloser::settlePlaceUnits(int slot, PlaceMap& map) {
+  const double own_sigma = map.keyframe(slot).unit_sigma;
+  bool agrees = true;
+  for (const int32_t g : verifier_.group()) {
+    const double sigma = map.keyframe(g).unit_sigma;
+    if (sigma < kUncertainUnit) continue;
+    if (own_sigma >= kUncertainUnit) {  // nothing surer to measure it with
+      ++stats_.units_unmeasured;
+      return false;
+    }
+    const LoopScale own = loopScale(verifier_.inliers(), detect_own_points_, features_per_camera_, found_.T_w_b,
+                                    verifier_.rig(), scale_scratch_, g);
+    if (placeUnit(sigma, own_sigma, own) != PlaceUnit::Other) continue;
+    spdlog::debug(
+        "place memory: keyframe {} finds the points of keyframe {} {:.4f} times as far as its own: they "
+        "take its unit",
+        map.keyframe(slot).id, map.keyframe(g).id, own.scale);
+    map.scalePoints(g, 1 / own.scale, camera_centers_);
+    ++stats_.places_rescaled;
+    agrees = false;
+  }
+  return agrees;
 }
 
 // A loop returns: within one segment, the path from the candidate to this keyframe must be much longer than

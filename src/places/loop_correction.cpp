@@ -39,9 +39,6 @@ Mat6 odometrySqrtInformation(const SE3& T_a_b, double unit_sigma) {
   return W;
 }
 
-// A loop's scale is measured from hundreds of point depths; no better than this, whatever their spread says.
-constexpr double kLoopLogScaleSigmaFloor = 0.005;
-
 Vec7 withScale(const Vec6& sigma, double log_scale_sigma) {
   Vec7 s;
   s << sigma, log_scale_sigma;
@@ -169,12 +166,12 @@ void LoopCorrection::build(Graph& graph, const PlaceMap& map, std::span<const Lo
   addLoops(graph, map, loops, graph.nodes());
 }
 
-LoopCorrection::Outcome LoopCorrection::take(PlaceMap& map, bool wait) {
+LoopCorrection::Outcome LoopCorrection::take(PlaceMap& map, bool wait, std::span<const Vec3> camera_centers) {
   if (!task_.running() || (!wait && !task_.ready())) return Outcome::None;
   task_.collect();
   if (map.reshapes() != graph_reshapes_) return Outcome::Stale;
-  if (rigid_) apply(*rigid_, map);
-  if (similar_) apply(*similar_, map);
+  if (rigid_) apply(*rigid_, map, camera_centers);
+  if (similar_) apply(*similar_, map, camera_centers);
   return Outcome::Applied;
 }
 
@@ -183,7 +180,7 @@ int LoopCorrection::newestNode(int32_t segment) const {
 }
 
 template <class Graph>
-void LoopCorrection::apply(const Graph& graph, PlaceMap& map) {
+void LoopCorrection::apply(const Graph& graph, PlaceMap& map, std::span<const Vec3> camera_centers) {
   using Pose = std::decay_t<decltype(graph.pose(0))>;
   for (int32_t s = 0; s < map.segments(); ++s) {
     const int newest = newestNode(s);
@@ -219,7 +216,7 @@ void LoopCorrection::apply(const Graph& graph, PlaceMap& map) {
         in_graph ? Sim3(graph.pose(node)) : segment_delta_[static_cast<std::size_t>(k.segment)] * Sim3(k.T_w_k);
     moved.normalize();
     map.setKeyframePose(slot, moved.rigid());
-    if (moved.s != 1.0) map.scaleKeyframe(slot, moved.s);
+    if (moved.s != 1.0) map.scaleKeyframe(slot, moved.s, camera_centers);
   }
 }
 

@@ -1,5 +1,6 @@
 #include "mcslam/places/loop_scale.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "mcslam/core/median.hpp"
@@ -14,11 +15,12 @@ constexpr int kMinSamples = 20;
 }  // namespace
 
 LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::Vector3f> own_points, int per_camera,
-                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch) {
+                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch, int keyframe) {
   LoopScale result;
   const SE3 T_b_w = T_w_b.inverse();
   std::size_t n = 0;
   for (const PlaceMatch& m : inliers) {
+    if (keyframe >= 0 && m.keyframe != keyframe) continue;
     const auto index =
         static_cast<std::size_t>(m.cam) * static_cast<std::size_t>(per_camera) + static_cast<std::size_t>(m.kp);
     if (index >= own_points.size() || n == scratch.size()) continue;
@@ -41,6 +43,13 @@ LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::
   // the mean's error.
   result.sigma_log_scale = 1.25 * 1.4826 * mad / std::sqrt(static_cast<double>(n));
   return result;
+}
+
+PlaceUnit placeUnit(double place_unit_sigma, double keyframe_unit_sigma, const LoopScale& scale) {
+  if (place_unit_sigma < kUncertainUnit) return PlaceUnit::Known;
+  if (keyframe_unit_sigma >= kUncertainUnit || !scale.ok) return PlaceUnit::Unmeasured;
+  const double allowed = 3 * std::max(scale.sigma_log_scale, kLoopLogScaleSigmaFloor);
+  return std::abs(std::log(scale.scale)) <= allowed ? PlaceUnit::Known : PlaceUnit::Other;
 }
 
 }  // namespace mcslam

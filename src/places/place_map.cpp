@@ -134,11 +134,24 @@ int PlaceMap::leastNeededKeyframe(std::span<const int64_t> kept) const {
   return best;
 }
 
-void PlaceMap::scaleKeyframe(int slot, double s) {
-  PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
-  k.unit *= s;
+void PlaceMap::scaleKeyframe(int slot, double s, std::span<const Vec3> camera_centers) {
+  keyframes_[static_cast<std::size_t>(slot)].unit *= s;
+  scalePoints(slot, s, camera_centers);
+}
+
+// What a unit changes is a point's depth along the ray of the camera that saw it; the camera's lever arm is metric.
+// Scaling the body-frame position instead would move the point off that ray by (s - 1) times the lever arm, and a
+// pose measured on the keyframe's points (a loop's) with it.
+void PlaceMap::scalePoints(int slot, double s, std::span<const Vec3> camera_centers) {
   PlacePoint* points = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
-  for (int i = 0; i < k.point_count; ++i) points[i].p_k *= static_cast<float>(s);
+  const int32_t count = keyframes_[static_cast<std::size_t>(slot)].point_count;
+  for (int i = 0; i < count; ++i) {
+    PlacePoint& p = points[i];
+    const bool known = p.cam >= 0 && static_cast<std::size_t>(p.cam) < camera_centers.size();
+    const Eigen::Vector3f c = known ? Eigen::Vector3f(camera_centers[static_cast<std::size_t>(p.cam)].cast<float>())
+                                    : Eigen::Vector3f::Zero();
+    p.p_k = c + static_cast<float>(s) * (p.p_k - c);
+  }
 }
 
 SE3 PlaceMap::toWorld(int32_t segment, const SE3& T_o_b) const {
@@ -154,7 +167,8 @@ SE3 PlaceMap::segmentPoseFor(int32_t segment, const SE3& T_w_b, const SE3& T_o_b
   return (Sim3(T_w_b, segmentScale(segment)) * Sim3(T_o_b).inverse()).rigid();
 }
 
-void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center, uint64_t from_frame) {
+void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center, uint64_t from_frame,
+                              std::span<const Vec3> camera_centers) {
   ++reshapes_;
   const Vec3 center_w = toWorld(segment, SE3(Mat3::Identity(), center)).t;
   for (int slot = 0; slot < capacity(); ++slot) {
@@ -162,8 +176,7 @@ void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center, uin
     if (!k.alive || k.segment != segment || k.frame_index < from_frame) continue;
     k.T_o_k.t = center + s * (k.T_o_k.t - center);
     k.T_w_k.t = center_w + s * (k.T_w_k.t - center_w);  // a loop's bending of the keyframe stays
-    PlacePoint* points = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
-    for (int i = 0; i < k.point_count; ++i) points[i].p_k *= static_cast<float>(s);
+    scalePoints(slot, s, camera_centers);
   }
 }
 

@@ -19,6 +19,7 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       loop_closer_(rig, options, odometry_options.scale_factor, max_features_per_camera,
                    rig.size() == 1 && options.monocular_loop_closure),
       seeds_(static_cast<std::size_t>(rig.size() * max_features_per_camera)),
+      camera_centers_(rig.cameraCenters()),
       landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1),
       features_per_camera_(max_features_per_camera),
       file_words_(options.max_words_per_keyframe),
@@ -27,8 +28,7 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       root_placed_(PlaceMap::kMaxSegments),
       root_anchored_(PlaceMap::kMaxSegments),
       vocabulary_fingerprint_(vocabularyFingerprint(vocabulary)) {
-  if (loop_closer_.similarity())
-    own_points_.resize(static_cast<std::size_t>(rig.size()) * static_cast<std::size_t>(max_features_per_camera));
+  own_points_.resize(static_cast<std::size_t>(rig.size()) * static_cast<std::size_t>(max_features_per_camera));
   for (int c = 0; c < rig.size(); ++c)
     cameras_.push_back({static_cast<uint32_t>(rig.model(c).width()), static_cast<uint32_t>(rig.model(c).height())});
   file_header_.cameras = cameras_;
@@ -42,7 +42,12 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   takeCorrection(options_.repeatable);
   followSegment(odometry);
   // Before the keyframes settled in this frame join: they are in the new unit already.
-  for (const Odometry::Rescale& r : odometry.rescales()) map_.rescaleSegment(segment_, r.s, r.center, r.from_frame);
+  if (!odometry.rescales().empty()) {
+    const Rig& rig = odometry.trackingRig();  // the lever arms the odometry rescaled its landmarks with
+    for (int c = 0; c < rig.size(); ++c) camera_centers_[static_cast<std::size_t>(c)] = rig.T_b_c(c).t;
+  }
+  for (const Odometry::Rescale& r : odometry.rescales())
+    map_.rescaleSegment(segment_, r.s, r.center, r.from_frame, camera_centers_);
   if (!localize_only_)
     for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
   if (out.state == TrackingState::Tracking && out.valid) {  // the odometry's path, for the drift it can have
@@ -145,7 +150,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
       if (!l.metric && local.observingKeyframes(lm) < 3) continue;
       PlacePoint p;
       p.p_k = (unit * (T_k_o * l.p_w)).cast<float>();
-      if (!own_points_.empty()) own_points_[static_cast<std::size_t>(c * features_per_camera_ + k)] = p.p_k;
+      own_points_[static_cast<std::size_t>(c * features_per_camera_ + k)] = p.p_k;
       p.descriptor = l.descriptor;
       p.node = vocabulary_.ancestor(vocabulary_.word(l.descriptor), levels_up);
       p.cam = static_cast<int16_t>(c);

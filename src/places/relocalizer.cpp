@@ -145,7 +145,7 @@ void Relocalizer::addMatch(const FrameFeatures& frame, const PlaceMap& map, int 
                            int keyframe, int& count) {
   const Keypoint& kp = frame.sets[static_cast<std::size_t>(c)].keypoints[static_cast<std::size_t>(k)];
   const Vec3 p_w = map.keyframe(keyframe).T_w_k * point->p_k.cast<double>();
-  matches_[static_cast<std::size_t>(count)] = {static_cast<int16_t>(c), k, p_w, point};
+  matches_[static_cast<std::size_t>(count)] = {static_cast<int16_t>(c), k, p_w, point, keyframe};
   observations_[static_cast<std::size_t>(count)] = makePoseObservation(
       rig_, c, Vec2(kp.x, kp.y), frame.bearings[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)], p_w,
       octave_sigma_[kp.octave]);

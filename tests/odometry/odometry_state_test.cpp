@@ -260,6 +260,51 @@ TEST(WindowBridge, SolvesReachLandmarksByIdAfterSlotReuse) {
   EXPECT_GT(closer, 0.9 * in_window);  // written back to their own slots
 }
 
+// A new unit changes how far the rig moved, not where its cameras sit on it: each landmark stays on the ray of the
+// newest camera that saw it, at s times the depth, while keyframes scale about the center. Scaling the landmarks
+// about the center too would move them off that ray by (s - 1) times the camera's lever arm.
+TEST(WindowBridge, ARescaleKeepsEachLandmarkOnItsNewestObserversRay) {
+  const Rig rig = test::nonOverlappingRig3();
+  OdometryOptions options;
+  options.backend_thread = false;
+  Map map(rig, 400, options.max_keyframes, 16);
+  // Three keyframes turning as they go; each landmark's observations listed oldest, newest, middle.
+  const SE3 poses[3] = {SE3(Mat3::Identity(), Vec3(0, 0, 0)),
+                        SE3(Eigen::AngleAxisd(0.15, Vec3::UnitY()).toRotationMatrix(), Vec3(0.1, 0, 0.25)),
+                        SE3(Eigen::AngleAxisd(0.3, Vec3::UnitY()).toRotationMatrix(), Vec3(0.2, 0, 0.5))};
+  int kfs[3] = {};
+  for (int k = 0; k < 3; ++k) {
+    kfs[k] = map.createKeyframe();
+    map.keyframe(kfs[k]).T_w_b = poses[k];
+  }
+  struct Seen {
+    int lm, newest_kf, cam;
+  };
+  std::vector<Seen> seen;
+  for (int c = 0; c < rig.size(); ++c) {
+    if (rig.T_b_c(c).t.norm() < 0.05) continue;  // no lever arm to get wrong
+    const int lm = map.createLandmark((poses[2] * rig.T_b_c(c)) * Vec3(0.3, -0.2, 4.0), Descriptor{}, 0);
+    map.addObservation(lm, kfs[0], c, 0);
+    map.addObservation(lm, kfs[2], c, 0);  // the newest by id, neither first nor last
+    map.addObservation(lm, kfs[1], c, 0);
+    seen.push_back({lm, kfs[2], c});
+  }
+  ASSERT_GE(seen.size(), 2u);
+  std::vector<Vec3> before;
+  for (const Seen& x : seen) before.push_back(map.landmark(x.lm).p_w);
+  WindowBridge bridge(rig, options, 400);
+  const double s = 1.6;
+  const Vec3 center(1, 0, -2);
+  bridge.rescale(map, s, center);
+  EXPECT_TRUE(map.keyframe(kfs[2]).T_w_b.t.isApprox(center + s * (poses[2].t - center)));
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    const Vec3 camera_before = (poses[2] * rig.T_b_c(seen[i].cam)).t;
+    const Vec3 camera_after = (map.keyframe(seen[i].newest_kf).T_w_b * rig.T_b_c(seen[i].cam)).t;
+    const Vec3 expected = camera_after + s * (before[i] - camera_before);
+    EXPECT_LT((map.landmark(seen[i].lm).p_w - expected).norm(), 1e-9) << "camera " << seen[i].cam;
+  }
+}
+
 // The time lost is the frames' own time since the loss began; a camera clock stepped back an hour (or a frame
 // delivered twice) neither holds the loss open nor ends it early: such stamps add nothing, and are counted.
 TEST(LossClock, AClockSteppedBackDoesNotHoldTheLossOpen) {

@@ -77,5 +77,49 @@ TEST(LoopScale, TooFewPointsOfItsOwnGiveNoScale) {
   EXPECT_EQ(r.samples, 19);
 }
 
+// Each place keyframe's matches measure its own unit: a group whose keyframes were made in different units.
+TEST(LoopScale, EachPlaceKeyframesMatchesMeasureItsOwnUnit) {
+  const SE3 T_w_b;
+  Scene s = scene(100, 1.2, 0, 0.01, T_w_b, 5);
+  const Scene other = scene(60, 0.7, 0, 0.01, T_w_b, 6);
+  for (PlaceMatch& m : s.inliers) m.keyframe = 3;
+  for (PlaceMatch m : other.inliers) {
+    m.kp += 1000;  // keypoints after the first scene's
+    m.keyframe = 8;
+    s.inliers.push_back(m);
+  }
+  s.own.resize(1000 + other.own.size(), Eigen::Vector3f::Constant(std::nanf("")));
+  std::copy(other.own.begin(), other.own.end(), s.own.begin() + 1000);
+  std::vector<double> scratch(512);
+  const auto at = [&](int keyframe) {
+    return loopScale(s.inliers, s.own, static_cast<int>(s.own.size()), T_w_b, oneCamera(), scratch, keyframe);
+  };
+  EXPECT_NEAR(at(3).scale, 1.2, 0.01);
+  EXPECT_NEAR(at(8).scale, 0.7, 0.01);
+  EXPECT_EQ(at(8).samples, 60);
+  EXPECT_FALSE(at(5).ok);  // none of its points matched
+}
+
+// A place made in a known unit takes any loop; one made while the unit was uncertain takes a loop only when the
+// keyframe, in a known unit itself, measures it in the same unit within the measurement's error.
+TEST(LoopScale, APlaceOfAnUncertainUnitTakesALoopOnlyInTheSameUnit) {
+  const SE3 T_w_b;
+  std::vector<double> scratch(512);
+  const auto measured = [&](double scale) {
+    const Scene s = scene(200, scale, 10, 0.02, T_w_b, 4);
+    return loopScale(s.inliers, s.own, static_cast<int>(s.own.size()), T_w_b, oneCamera(), scratch);
+  };
+  const LoopScale same = measured(1.0), other = measured(1.25);
+  ASSERT_TRUE(same.ok && other.ok);
+  EXPECT_EQ(placeUnit(0.02, 0.01, other), PlaceUnit::Known);  // made in a known unit: its depths are not in doubt
+  EXPECT_EQ(placeUnit(1.0, 0.01, same), PlaceUnit::Known);
+  EXPECT_EQ(placeUnit(1.0, 0.01, other), PlaceUnit::Other);
+  EXPECT_EQ(placeUnit(0.3, 0.5, other), PlaceUnit::Unmeasured);  // nothing surer to measure it with
+  EXPECT_EQ(placeUnit(1.0, 0.01, LoopScale{}), PlaceUnit::Unmeasured);
+  // Within three of the measurement's standard deviations (and no less than 1.5%): the same unit.
+  EXPECT_EQ(placeUnit(1.0, 0.01, measured(1.01)), PlaceUnit::Known);
+  EXPECT_EQ(placeUnit(1.0, 0.01, measured(1.04)), PlaceUnit::Other);
+}
+
 }  // namespace
 }  // namespace mcslam

@@ -48,7 +48,7 @@ PlaceMap sampleMap() {
     map.finishKeyframe(k);
     map.setUnitSigma(k, 0.1 * i);  // made while a rig without overlap was finding its unit
   }
-  map.scaleKeyframe(3, 1.25);
+  map.scaleKeyframe(3, 1.25, {});
   map.eraseKeyframe(2);
   return map;
 }

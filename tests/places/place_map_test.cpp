@@ -148,7 +148,7 @@ Straight straight() {
 
 TEST(PlaceMap, AnArbitraryUnitIsRescaledEverywhere) {
   Straight d = straight();
-  d.map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0));  // from frame 0
+  d.map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0), /*from_frame=*/0, {});
   EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_o_k.t.isApprox(Vec3(-2, 0, 0)));
   EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_w_k.t.isApprox(Vec3(-2, 10, 0)));
   EXPECT_TRUE(d.map.keyframe(d.slots[3]).T_w_k.t.isApprox(Vec3(10, 10, 0)));
@@ -156,10 +156,34 @@ TEST(PlaceMap, AnArbitraryUnitIsRescaledEverywhere) {
   EXPECT_FLOAT_EQ(d.map.points(d.slots[0])[0].p_k.z(), 2.0f);
 }
 
+// A unit scales a point's depth from the camera that saw it: its lever arm (metric) stays, so the point stays on
+// that camera's ray, and a loop measured on it later is not off by (s - 1) times the lever arm. A point whose
+// camera is not among the centres scales about the body.
+TEST(PlaceMap, APointScalesAlongTheRayOfTheCameraThatSawIt) {
+  Straight d = straight();
+  PlaceMap& map = d.map;
+  const int slot = map.createKeyframe(d.segment, 9, 200, SE3(), SE3());
+  PlacePoint side = pointAt(1, 90), unknown = pointAt(2, 91);
+  side.cam = 1;
+  side.p_k = Eigen::Vector3f(0.3f, 0.f, 2.f);
+  unknown.cam = 5;
+  map.addPoint(slot, side);
+  map.addPoint(slot, unknown);
+  map.finishKeyframe(slot);
+  const std::vector<Vec3> centers{Vec3::Zero(), Vec3(0.3, 0, 0.1)};
+  map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0), /*from_frame=*/0, centers);
+  const auto p = map.points(slot);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_TRUE(p[0].p_k.isApprox(Eigen::Vector3f(0.3f, 0.f, 3.9f)));  // 0.1 + 2 (2 - 0.1)
+  EXPECT_TRUE(p[1].p_k.isApprox(Eigen::Vector3f(4.f, 0.f, 2.f)));
+  map.scaleKeyframe(slot, 0.5, centers);  // a Sim(3) loop's scale, the same way
+  EXPECT_TRUE(map.points(slot)[0].p_k.isApprox(Eigen::Vector3f(0.3f, 0.f, 2.f)));
+}
+
 TEST(PlaceMap, ADriftedUnitIsRescaledFromTheEstimatesWindowOn) {
   Straight d = straight();
   const uint64_t reshapes = d.map.reshapes();
-  d.map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0), /*from_frame=*/101);
+  d.map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0), /*from_frame=*/101, {});
   // Made before the window: as they were, so that the motion between them keeps its length.
   EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_o_k.t.isApprox(Vec3(0, 0, 0)));
   EXPECT_TRUE(d.map.keyframe(d.slots[0]).T_w_k.t.isApprox(Vec3(0, 10, 0)));

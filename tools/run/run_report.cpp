@@ -177,6 +177,8 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("loops_consistent").value(l.consistent);
     j.key("loop_closures").value(l.closures);
     j.key("map_merges").value(l.merges);
+    j.key("loop_places_rescaled").value(l.places_rescaled);  // a loop found a place's points in another unit
+    j.key("loop_units_unmeasured").value(l.units_unmeasured);
     j.key("loop_queries_skipped").value(l.skipped);  // while a correction was being solved
     j.key("loop_detection_waits").value(l.waits);    // frames that waited for the detection thread (--live)
     j.key("world_revision").value(static_cast<unsigned long long>(places->worldRevision()));

@@ -36,6 +36,12 @@ class Rig {
   int size() const { return static_cast<int>(cameras.size()); }
   const CameraModel& model(int cam) const { return cameras[cam].model; }
   const SE3& T_b_c(int cam) const { return cameras[cam].T_b_c; }
+  // Each camera's centre in the body frame, in camera order (allocates).
+  std::vector<Vec3> cameraCenters() const {
+    std::vector<Vec3> centers;
+    for (const RigCamera& c : cameras) centers.push_back(c.T_b_c.t);
+    return centers;
+  }
 
   // Bearing in camera `cam` -> Plücker ray in the body frame.
   PluckerRay ray(int cam, const Vec3& bearing_c) const {

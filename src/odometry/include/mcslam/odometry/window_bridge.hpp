@@ -53,8 +53,9 @@ class WindowBridge {
 
   // Landmark `lm` leaves the window (before the map erases it).
   void removeLandmark(Map& map, int lm);
-  // Multiplies every keyframe position and landmark, in the map and in the window, about `center` (a new metric
-  // scale). No solve may be in flight.
+  // The map's unit changes by `s` about `center` (a new metric scale), in the map and in the window: keyframe
+  // positions become center + s (p - center), and each landmark's depth from the newest camera that saw it is
+  // multiplied by s (the cameras' lever arms were metric all along). No solve may be in flight.
   void rescale(Map& map, double s, const Vec3& center);
   // Whether the window holds its scale (OdometryOptions::hold_window_scale, else its two oldest keyframes fixed)
   // instead of letting its reprojections pull it: for a map whose unit only explicit rescales may change (a rig
@@ -76,6 +77,8 @@ class WindowBridge {
   void removeOutliers(Map& map);
   void writeBack(Map& map);
   int keyframeSlotOfId(const Map& map, int64_t id) const;
+  // R_w_b t_b_c of the camera of `l`'s observation in its newest keyframe (zero without one).
+  Vec3 leverArmOfNewestObserver(const Map& map, const Landmark& l) const;
 
   struct WindowSolve final : BackgroundJob {
     void run() override;

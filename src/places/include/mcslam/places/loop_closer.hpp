@@ -31,6 +31,11 @@ struct LoopStats {
   uint64_t skipped = 0;     // keyframes not queried: a correction was being solved
   uint64_t waits = 0;       // frames that had to wait for a detection to finish before writing the map
   uint64_t restarted = 0;   // corrections solved again: a segment was moved or rescaled during the solve
+  // Loops onto places made while the unit was uncertain (PlaceUnit): the place keyframes whose points a loop found
+  // in another unit and rescaled (that loop not closed), and the loops not closed because the recognizing
+  // keyframe's own unit was uncertain too.
+  uint64_t places_rescaled = 0;
+  uint64_t units_unmeasured = 0;
   int64_t last_keyframe = -1, last_candidate = -1;  // place keyframe ids of the last closure
   double last_correction_m = 0, last_correction_deg = 0;
   double last_solve_ms = 0;
@@ -53,17 +58,18 @@ class LoopCloser {
   bool similarity() const { return correction_.similarity(); }
 
   // The extrinsics the next detection projects with. Not while a detection is in flight.
-  void setRig(const Rig& rig) { verifier_.setRig(rig); }
+  void setRig(const Rig& rig);
   // Keyframe `slot` was just added to `map`, with its words to `database` (`features`: the frame it was made of;
-  // `own_points`: for Sim(3) loops, its own point of each keypoint as loopScale() takes them, else empty): starts
+  // `own_points`: its own point of each keypoint as loopScale() takes them, for a loop's scale): starts
   // looking for a loop it closes on the detection thread (copying `features`, `words` and `own_points`). Until
   // collectDetection() took the result, `map` and `database` must not be written, nor another detection started.
   void startDetection(int slot, const FrameFeatures& features, const FrameWords& words, const PlaceMap& map,
                       const PlaceDatabase& database, std::span<const Eigen::Vector3f> own_points = {});
   // Takes the result of the detection in flight, waiting for it with `wait` (otherwise only when it is ready), and
   // decides on it: true when it closed a loop, whose correction is then being solved; the map does not move until
-  // takeCorrection(). `map` is the one the detection started on, unchanged.
-  bool collectDetection(const PlaceMap& map, bool wait);
+  // takeCorrection(). `map` is the one the detection started on, unchanged; a loop onto places whose unit was
+  // uncertain may give their points the unit it measured (settlePlaceUnits).
+  bool collectDetection(PlaceMap& map, bool wait);
   // At a frame boundary: a correction solved since moves the map's keyframes and segments' frames (true). With
   // `wait`, one in flight is waited for; without, it is taken at the first call that finds it ready.
   bool takeCorrection(PlaceMap& map, bool wait);
@@ -94,7 +100,9 @@ class LoopCloser {
 
   void detect();
   // What the detection found for keyframe `slot` decides whether it closes a loop (onto the processing thread).
-  bool decide(int slot, const RelocalizationResult& found, const PlaceMap& map);
+  bool decide(int slot, const RelocalizationResult& found, PlaceMap& map);
+  // Whether the loop's places are in this keyframe's unit; those found in another take it (false then).
+  bool settlePlaceUnits(int slot, PlaceMap& map);
   bool followsLast(int slot, const PlaceMap& map) const;
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
   bool consistentWithLast(int slot, const PlaceMap& map, const Sim3& correction, const LoopScale& scale) const;
@@ -110,7 +118,8 @@ class LoopCloser {
   std::vector<int32_t> segment_root_;  // union-find over segments joined by loops
   std::vector<int32_t> roots_;         // scratch of startCorrection(): each segment's root
   LoopCorrection correction_;
-  bool correction_wanted_ = false;  // a loop was accepted (or a solve went stale): solve (again)
+  std::vector<Vec3> camera_centers_;  // of the rig the detections project with, in the body frame
+  bool correction_wanted_ = false;    // a loop was accepted (or a solve went stale): solve (again)
   // The last accepted loop, for the log when its correction lands.
   struct Accepted {
     int64_t keyframe = -1, candidate = -1;
@@ -134,7 +143,7 @@ class LoopCloser {
   FrameFeatures detect_features_;
   FrameWords detect_words_;
   int features_per_camera_ = 0;
-  std::vector<Eigen::Vector3f> detect_own_points_;  // Sim(3) loops: the keyframe's own points by keypoint
+  std::vector<Eigen::Vector3f> detect_own_points_;  // the keyframe's own points by keypoint (a loop's scale)
   std::vector<double> scale_scratch_;
   RelocalizationResult found_;
   LoopScale found_scale_;

@@ -51,7 +51,9 @@ class LoopCorrection {
     Stale,    // a segment was moved or rescaled during the solve (PlaceMap::reshapes): start again
   };
   // At a frame boundary. With `wait`, waits for a solve in flight.
-  Outcome take(PlaceMap& map, bool wait);
+  // `camera_centers`: each camera's centre in the body frame, about which a keyframe's points scale in a Sim(3)
+  // correction (PlaceMap::scaleKeyframe).
+  Outcome take(PlaceMap& map, bool wait, std::span<const Vec3> camera_centers = {});
   double lastSolveMs() const { return task_.lastMilliseconds(); }
   const backend::PoseGraphSummary& lastSummary() const { return solve_.summary; }  // of the solve last taken
   uint64_t threadAllocations() const { return task_.allocations(); }  // by the solving thread; any thread may ask
@@ -68,7 +70,7 @@ class LoopCorrection {
   void build(Graph& graph, const PlaceMap& map, std::span<const LoopEdge> loops,
              std::span<const int32_t> root_of_segment);
   template <class Graph>
-  void apply(const Graph& graph, PlaceMap& map);
+  void apply(const Graph& graph, PlaceMap& map, std::span<const Vec3> camera_centers);
   int newestNode(int32_t segment) const;  // the segment's newest keyframe in the graph being solved, or -1
   template <class Graph>
   void addLoops(Graph& graph, const PlaceMap& map, std::span<const LoopEdge> loops, int nodes);

@@ -85,14 +85,20 @@ class PlaceMap {
 
   const PlaceKeyframe& keyframe(int slot) const { return keyframes_[static_cast<std::size_t>(slot)]; }
   void setKeyframePose(int slot, const SE3& T_w_k) { keyframes_[static_cast<std::size_t>(slot)].T_w_k = T_w_k; }
-  // A Sim(3) loop correction scaled the keyframe's surroundings by `s` about its body: its unit and points follow.
-  void scaleKeyframe(int slot, double s);
+  // A Sim(3) loop correction scaled the keyframe's surroundings by `s`: its unit and points follow, each point's
+  // depth from the camera that saw it (`camera_centers`: each camera's centre in the body frame; a point of a camera
+  // not in it scales about the body).
+  void scaleKeyframe(int slot, double s, std::span<const Vec3> camera_centers);
+  // Keyframe `slot`'s points take a unit `s` times the one they were in (a loop measured it), as scaleKeyframe's;
+  // its pose and unit stay.
+  void scalePoints(int slot, double s, std::span<const Vec3> camera_centers);
   // The segment's odometry took a new unit (positions p became center + s (p - center) in its frame) for the motion
   // since frame `from_frame`: the keyframes made from then on follow (their odometry and world poses, about the
-  // center in either frame, and their points); those made before keep their poses, so that the motion between
-  // them keeps its length (the motion of a map whose unit drifted was right when it was made; a map whose unit was
-  // arbitrary rescales all of it, from frame 0).
-  void rescaleSegment(int32_t segment, double s, const Vec3& center, uint64_t from_frame = 0);
+  // center in either frame, and their points as scaleKeyframe's); those made before keep their poses, so that the
+  // motion between them keeps its length (the motion of a map whose unit drifted was right when it was made; a map
+  // whose unit was arbitrary rescales all of it, from frame 0).
+  void rescaleSegment(int32_t segment, double s, const Vec3& center, uint64_t from_frame,
+                      std::span<const Vec3> camera_centers);
   std::span<const PlacePoint> points(int slot) const {
     return {points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_),
             static_cast<std::size_t>(keyframes_[static_cast<std::size_t>(slot)].point_count)};

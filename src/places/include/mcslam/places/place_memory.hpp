@@ -102,9 +102,10 @@ class PlaceMemory {
   Relocalizer relocalizer_;
   LoopCloser loop_closer_;
   std::vector<MapSeed> seeds_;
+  std::vector<Vec3> camera_centers_;  // in the body frame, as of the odometry's last rescale (PlaceMap::rescaleSegment)
   std::vector<int64_t> landmark_stamp_;  // per odometry landmark slot: the keyframe id it was last added for
-  // One camera: the last keyframe's own point of each keypoint (cam * max features + kp; NaN: none), for the scale
-  // of a Sim(3) loop. Empty otherwise.
+  // The last keyframe's own point of each keypoint (cam * max features + kp; NaN: none), for the scale of a loop
+  // (LoopScale).
   std::vector<Eigen::Vector3f> own_points_;
   int features_per_camera_ = 0;
   int32_t segment_ = -1;

@@ -30,6 +30,7 @@ struct PlaceMatch {
   int32_t kp = -1;
   Vec3 p_w = Vec3::Zero();
   const PlacePoint* point = nullptr;
+  int32_t keyframe = -1;  // the place keyframe (slot) whose point it is
 };
 
 struct RelocalizationResult {
@@ -95,6 +96,9 @@ class Relocalizer {
 
   // The inlier matches of the last successful locate().
   std::span<const PlaceMatch> inliers() const { return {inliers_.data(), static_cast<std::size_t>(inlier_count_)}; }
+  // The keyframes (slots) whose points the last verification matched: the candidate and its neighbours; those of
+  // the accepted candidate right after a successful locate(), which returns at its first success.
+  std::span<const int32_t> group() const { return {group_.data(), static_cast<std::size_t>(group_count_)}; }
 
  private:
   bool verify(const FrameFeatures& frame, const FrameWords& words, const PlaceMap& map, int keyframe,
