@@ -115,10 +115,11 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, PlaceMap& map) 
     return false;
   }
   const PlaceKeyframe& k = map.keyframe(slot);
+  const int place = measuringPlace();
   const SE3 correction = r.T_w_b * k.T_w_k.inverse();  // moves the drifted keyframe onto the recognized place
   // In Sim(3), what moves the keyframe's surroundings (in its unit) onto the place's.
   const Sim3 similarity_correction = Sim3(r.T_w_b, found_scale_.scale) * Sim3(k.T_w_k).inverse();
-  const int64_t candidate = map.keyframe(r.keyframe).id;
+  const int64_t candidate = map.keyframe(place).id;
   const bool confirmed = similarity() ? consistentWithLast(slot, map, similarity_correction, found_scale_)
                                       : consistentWithLast(slot, map, correction);
   spdlog::debug(
@@ -148,9 +149,9 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, PlaceMap& map) 
     return false;
   }
   // Kept in the two keyframes' odometry units, which later Sim(3) corrections do not change (their units do).
-  const double unit_a = map.keyframe(r.keyframe).unit, unit_b = k.unit;
+  const double unit_a = map.keyframe(place).unit, unit_b = k.unit;
   LoopEdge& loop = loops_[static_cast<std::size_t>(loop_count_++)];
-  loop = {candidate, k.id, map.keyframe(r.keyframe).T_w_k.inverse() * r.T_w_b, sigma, 1.0, 0.0};
+  loop = {candidate, k.id, map.keyframe(place).T_w_k.inverse() * r.T_w_b, sigma, 1.0, 0.0};
   if (similarity()) {
     loop.T_a_b.t /= unit_a;
     loop.sigma.head<3>() /= unit_a;
@@ -158,12 +159,12 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, PlaceMap& map) 
     loop.sigma_log_scale = found_scale_.sigma_log_scale;
   }
   const int32_t root_k = findRoot(k.segment);
-  const int32_t root_c = findRoot(map.keyframe(r.keyframe).segment);
+  const int32_t root_c = findRoot(map.keyframe(place).segment);
   if (root_k != root_c) {
     segment_root_[static_cast<std::size_t>(std::max(root_k, root_c))] = std::min(root_k, root_c);
     ++stats_.merges;
   }
-  accepted_ = {k.id, candidate, k.t, map.keyframe(r.keyframe).t, r.inliers, correction};
+  accepted_ = {k.id, candidate, k.t, map.keyframe(place).t, r.inliers, correction};
   pending_keyframe_ = -1;
   correction_wanted_ = true;
   startCorrection(map);
@@ -228,6 +229,23 @@ bool LoopCloser::settlePlaceUnits(int slot, PlaceMap& map) {
     agrees = false;
   }
   return agrees;
+}
+
+// The database proposed the candidate for its words; the loop joins the place whose points measured it: the
+// keyframe of the verified group with the most inliers. The candidate's neighbours can hold them all: the first
+// keyframes of a map started from two frames keep no points (none was certain enough), and a loop joined to one of
+// them would hold the rest of the map to where that keyframe happened to be.
+int LoopCloser::measuringPlace() const {
+  int best = -1, best_count = -1;
+  for (const int32_t g : verifier_.group()) {
+    int count = 0;
+    for (const PlaceMatch& m : verifier_.inliers()) count += m.keyframe == g ? 1 : 0;
+    if (count > best_count) {
+      best = g;
+      best_count = count;
+    }
+  }
+  return best;
 }
 
 // A loop returns: within one segment, the path from the candidate to this keyframe must be much longer than

@@ -103,6 +103,8 @@ class LoopCloser {
   bool decide(int slot, const RelocalizationResult& found, PlaceMap& map);
   // Whether the loop's places are in this keyframe's unit; those found in another take it (false then).
   bool settlePlaceUnits(int slot, PlaceMap& map);
+  // The place keyframe (slot) of the verified group whose points hold the most inliers (the candidate first).
+  int measuringPlace() const;
   bool followsLast(int slot, const PlaceMap& map) const;
   bool consistentWithLast(int slot, const PlaceMap& map, const SE3& correction) const;
   bool consistentWithLast(int slot, const PlaceMap& map, const Sim3& correction, const LoopScale& scale) const;
