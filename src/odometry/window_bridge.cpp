@@ -97,7 +97,7 @@ void WindowBridge::rescale(Map& map, double s, const Vec3& center) {
 
 // What was in the wrong unit is the rig's motion, not its lever arms: a landmark's depth along the ray of a camera
 // that saw it is what scales, about that camera's centre. Scaling about the body would move the point off every
-// ray by (s - 1) times the lever arm (decimetres on a rig without overlap, and the next frame's pose with it).
+// ray by (s - 1) times the lever arm, and the next frame's pose with it.
 // The newest observer is the camera tracking continues near; older ones differ from it only by the rig's rotation
 // since.
 Vec3 WindowBridge::leverArmOfNewestObserver(const Map& map, const Landmark& l) const {

@@ -199,8 +199,7 @@ void LoopCorrection::apply(const Graph& graph, PlaceMap& map, std::span<const Ve
         parent >= 0 && newestNode(parent) >= 0 ? segment_delta_[static_cast<std::size_t>(parent)] : Sim3();
   }
   // Rotations are made orthonormal again: each correction composes the segment's frame with the last one, and its
-  // newest keyframe's pose with that frame, so a rounding error of the rotation would double with every correction
-  // (after a few dozen, the published pose ran away by metres).
+  // newest keyframe's pose with that frame, so a rounding error of the rotation would double with every correction.
   for (int32_t s = 0; s < map.segments(); ++s) {
     Sim3 moved = segment_delta_[static_cast<std::size_t>(s)] * map.segmentSimilarity(s);
     moved.normalize();
