@@ -16,23 +16,7 @@ import argparse
 import math
 import sys
 
-
-def load(path):
-    poses = {}
-    with open(path) as f:
-        for n, line in enumerate(f, 1):
-            if line.startswith('#') or not line.strip():
-                continue
-            v = line.replace(',', ' ').split()
-            try:
-                t = float(v[0])
-                p = tuple(float(x) for x in v[1:4])
-            except (ValueError, IndexError):
-                sys.exit(f"{path}:{n}: expected 'timestamp x y z ...', got: {line.strip()[:60]}")
-            if t > 1e12:  # nanoseconds (EuRoC)
-                t *= 1e-9
-            poses[round(t, 3)] = p
-    return poses
+from tum_poses import load_poses
 
 
 def main():
@@ -47,7 +31,7 @@ def main():
     ap.add_argument('--span', nargs=2, type=int, metavar=('FIRST', 'LAST'),
                     help='also print the path travelled between these poses over the true one')
     a = ap.parse_args()
-    gt, est = load(a.groundtruth), load(a.estimate)
+    gt, est = load_poses(a.groundtruth, 3), load_poses(a.estimate, 3)
     ts = sorted(t for t in est if t in gt)
     if len(ts) <= a.frames:
         sys.exit(f"only {len(ts)} poses of {a.estimate} have a ground-truth pose at the same time (need > {a.frames})")

@@ -10,25 +10,7 @@ import argparse
 import math
 import sys
 
-
-def load(path):
-    poses = {}
-    with open(path) as f:
-        for n, line in enumerate(f, 1):
-            if line.startswith('#') or not line.strip():
-                continue
-            v = line.replace(',', ' ').split()
-            try:
-                t = float(v[0])
-                pose = tuple(float(x) for x in v[1:8])
-            except (ValueError, IndexError):
-                sys.exit(f"{path}:{n}: expected 'timestamp x y z qx qy qz qw', got: {line.strip()[:60]}")
-            if len(pose) != 7:
-                sys.exit(f"{path}:{n}: expected 'timestamp x y z qx qy qz qw', got: {line.strip()[:60]}")
-            if t > 1e12:  # nanoseconds (EuRoC)
-                t *= 1e-9
-            poses[round(t, 3)] = pose
-    return poses
+from tum_poses import load_poses
 
 
 def rotation(qx, qy, qz, qw):
@@ -49,7 +31,7 @@ def main():
     ap.add_argument('groundtruth')
     ap.add_argument('estimate')
     a = ap.parse_args()
-    gt, est = load(a.groundtruth), load(a.estimate)
+    gt, est = load_poses(a.groundtruth, 7), load_poses(a.estimate, 7)
     ts = sorted(t for t in est if t in gt)
     if len(ts) < 2:
         sys.exit(f"only {len(ts)} poses of {a.estimate} have a ground-truth pose at the same time (need 2)")
