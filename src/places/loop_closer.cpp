@@ -44,8 +44,7 @@ LoopCloser::LoopCloser(const Rig& rig, const PlacesOptions& options, float scale
 
 void LoopCloser::setRig(const Rig& rig) {
   verifier_.setRig(rig);
-  for (int c = 0; c < rig.size() && c < static_cast<int>(camera_centers_.size()); ++c)
-    camera_centers_[static_cast<std::size_t>(c)] = rig.T_b_c(c).t;
+  rig.cameraCenters(camera_centers_);
 }
 
 void LoopCloser::clear() {

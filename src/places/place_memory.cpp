@@ -42,10 +42,8 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   takeCorrection(options_.repeatable);
   followSegment(odometry);
   // Before the keyframes settled in this frame join: they are in the new unit already.
-  if (!odometry.rescales().empty()) {
-    const Rig& rig = odometry.trackingRig();  // the lever arms the odometry rescaled its landmarks with
-    for (int c = 0; c < rig.size(); ++c) camera_centers_[static_cast<std::size_t>(c)] = rig.T_b_c(c).t;
-  }
+  // The lever arms the odometry rescaled its landmarks with.
+  if (!odometry.rescales().empty()) odometry.trackingRig().cameraCenters(camera_centers_);
   for (const Odometry::Rescale& r : odometry.rescales())
     map_.rescaleSegment(segment_, r.s, r.center, r.from_frame, camera_centers_);
   if (!localize_only_)

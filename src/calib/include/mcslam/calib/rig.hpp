@@ -2,6 +2,7 @@
 // A rig of N >= 1 rigidly mounted cameras seen as one generalized camera (paper, section IV-B).
 // The body frame is cam0 unless the calibration or the configuration says otherwise.
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -36,10 +37,13 @@ class Rig {
   int size() const { return static_cast<int>(cameras.size()); }
   const CameraModel& model(int cam) const { return cameras[cam].model; }
   const SE3& T_b_c(int cam) const { return cameras[cam].T_b_c; }
-  // Each camera's centre in the body frame, in camera order (allocates).
+  // Each camera's centre in the body frame, in camera order: into `out` (as many as it holds), or a new vector.
+  void cameraCenters(std::span<Vec3> out) const {
+    for (std::size_t c = 0; c < out.size() && c < cameras.size(); ++c) out[c] = cameras[c].T_b_c.t;
+  }
   std::vector<Vec3> cameraCenters() const {
-    std::vector<Vec3> centers;
-    for (const RigCamera& c : cameras) centers.push_back(c.T_b_c.t);
+    std::vector<Vec3> centers(cameras.size());
+    cameraCenters(centers);
     return centers;
   }
 
