@@ -53,6 +53,7 @@ void LoopCloser::clear() {
   loop_count_ = 0;
   for (int32_t s = 0; s < PlaceMap::kMaxSegments; ++s) segment_root_[static_cast<std::size_t>(s)] = s;
   pending_keyframe_ = -1;
+  remeasured_keyframe_ = -1;
 }
 
 void LoopCloser::startDetection(int slot, const FrameFeatures& features, const FrameWords& words, const PlaceMap& map,
@@ -66,6 +67,7 @@ void LoopCloser::startDetection(int slot, const FrameFeatures& features, const F
   }
   ++stats_.queries;
   detect_slot_ = slot;
+  detect_keyframe_id_ = map.keyframe(slot).id;
   detect_map_ = &map;
   detect_database_ = &database;
   detect_features_ = features;  // same capacities: no allocation
@@ -94,13 +96,17 @@ void LoopCloser::detect() {
 }
 
 bool LoopCloser::collectDetection(PlaceMap& map, bool wait) {
-  if (!detection_task_.running()) return false;
-  if (!detection_task_.ready()) {
-    if (!wait) return false;
-    ++stats_.waits;
+  bool closed = false;
+  // A decision may measure the loop again (remeasure): a caller that waits is about to write the map.
+  while (detection_task_.running()) {
+    if (!detection_task_.ready()) {
+      if (!wait) break;
+      ++stats_.waits;
+    }
+    detection_task_.collect();
+    closed = decide(detect_slot_, found_, map) || closed;
   }
-  detection_task_.collect();
-  return decide(detect_slot_, found_, map);
+  return closed;
 }
 
 bool LoopCloser::decide(int slot, const RelocalizationResult& r, PlaceMap& map) {
@@ -109,7 +115,13 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, PlaceMap& map) 
     return false;
   }
   ++stats_.verified;
-  if (!closesALoop(map, r.keyframe, slot) || (!similarity() && !settlePlaceUnits(slot, map))) {
+  if (!closesALoop(map, r.keyframe, slot)) {
+    pending_keyframe_ = -1;
+    return false;
+  }
+  const PlaceUnits units = similarity() ? PlaceUnits::Agree : settlePlaceUnits(slot, map);
+  if (units == PlaceUnits::Differ && remeasure(slot)) return false;  // the last keyframe's detection stays pending
+  if (units != PlaceUnits::Agree) {
     pending_keyframe_ = -1;
     return false;
   }
@@ -203,31 +215,49 @@ void LoopCloser::startCorrection(const PlaceMap& map) {
 }
 
 // The verification matched the points of the candidate and its neighbours, each in the unit of its own time
-// (PlaceUnit). Each of uncertain unit is measured against this keyframe's own points on its own matches; one in
-// another unit takes the unit they measured, and the loop is left for the next keyframe to measure again on them.
-// One with too few matches of its own adds too little to the pose to decide.
-bool LoopCloser::settlePlaceUnits(int slot, PlaceMap& map) {
+// (PlaceUnit). Each camera's points of a place of uncertain unit, not measured yet, are measured against this
+// keyframe's own points on their own matches and take the unit they measured: hundreds of depths know it better
+// than the odometry did. Per camera: before the unit was known, the motion was in one unit and the lever arms in
+// metres, so each camera's depths came out in a unit of their own. When one was off beyond the measurement's error,
+// so is the pose measured on it. A camera with too few matches of its own adds too little to the pose to decide.
+LoopCloser::PlaceUnits LoopCloser::settlePlaceUnits(int slot, PlaceMap& map) {
   const double own_sigma = map.keyframe(slot).unit_sigma;
-  bool agrees = true;
+  const int cameras = verifier_.rig().size();
+  PlaceUnits units = PlaceUnits::Agree;
   for (const int32_t g : verifier_.group()) {
-    const double sigma = map.keyframe(g).unit_sigma;
-    if (sigma < kUncertainUnit) continue;
-    if (own_sigma >= kUncertainUnit) {  // nothing surer to measure it with
-      ++stats_.units_unmeasured;
-      return false;
+    const PlaceKeyframe& place = map.keyframe(g);
+    if (place.unit_sigma < kUncertainUnit) continue;
+    for (int cam = 0; cam < cameras; ++cam) {
+      if (place.cameras_unit_measured & (uint64_t{1} << cam)) continue;
+      if (own_sigma >= kUncertainUnit) {  // nothing surer to measure it with
+        ++stats_.units_unmeasured;
+        return PlaceUnits::Unmeasurable;
+      }
+      const LoopScale own = loopScale(verifier_.inliers(), detect_own_points_, features_per_camera_, found_.T_w_b,
+                                      verifier_.rig(), scale_scratch_, g, cam);
+      const PlaceUnit unit = placeUnit(place.unit_sigma, own_sigma, own);
+      if (unit == PlaceUnit::Unmeasured) continue;
+      spdlog::debug(
+          "place memory: keyframe {} finds camera {}'s points of keyframe {} {:.4f} +- {:.4f} times as far as its "
+          "own ({} points): they take its unit",
+          map.keyframe(slot).id, cam, place.id, own.scale, own.sigma_log_scale, own.samples);
+      map.takeMeasuredUnit(g, cam, 1 / own.scale, camera_centers_);
+      ++stats_.places_rescaled;
+      if (unit == PlaceUnit::Other) units = PlaceUnits::Differ;
     }
-    const LoopScale own = loopScale(verifier_.inliers(), detect_own_points_, features_per_camera_, found_.T_w_b,
-                                    verifier_.rig(), scale_scratch_, g);
-    if (placeUnit(sigma, own_sigma, own) != PlaceUnit::Other) continue;
-    spdlog::debug(
-        "place memory: keyframe {} finds the points of keyframe {} {:.4f} times as far as its own: they "
-        "take its unit",
-        map.keyframe(slot).id, map.keyframe(g).id, own.scale);
-    map.scalePoints(g, 1 / own.scale, camera_centers_);
-    ++stats_.places_rescaled;
-    agrees = false;
   }
-  return agrees;
+  return units;
+}
+
+// The loop is measured again, on the detection thread, on the points that took the keyframe's unit: once per
+// keyframe, unless a correction is about to move the map.
+bool LoopCloser::remeasure(int slot) {
+  if (remeasured_keyframe_ == detect_keyframe_id_ || correcting()) return false;
+  remeasured_keyframe_ = detect_keyframe_id_;
+  ++stats_.remeasured;
+  detect_slot_ = slot;
+  detection_task_.start(detection_);
+  return true;
 }
 
 // The database proposed the candidate for its words; the loop joins the place whose points measured it: the

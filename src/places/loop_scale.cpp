@@ -15,12 +15,12 @@ constexpr int kMinSamples = 20;
 }  // namespace
 
 LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::Vector3f> own_points, int per_camera,
-                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch, int keyframe) {
+                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch, int keyframe, int cam) {
   LoopScale result;
   const SE3 T_b_w = T_w_b.inverse();
   std::size_t n = 0;
   for (const PlaceMatch& m : inliers) {
-    if (keyframe >= 0 && m.keyframe != keyframe) continue;
+    if ((keyframe >= 0 && m.keyframe != keyframe) || (cam >= 0 && m.cam != cam)) continue;
     const auto index =
         static_cast<std::size_t>(m.cam) * static_cast<std::size_t>(per_camera) + static_cast<std::size_t>(m.kp);
     if (index >= own_points.size() || n == scratch.size()) continue;

@@ -142,16 +142,25 @@ void PlaceMap::scaleKeyframe(int slot, double s, std::span<const Vec3> camera_ce
 // What a unit changes is a point's depth along the ray of the camera that saw it; the camera's lever arm is metric.
 // Scaling the body-frame position instead would move the point off that ray by (s - 1) times the lever arm, and a
 // pose measured on the keyframe's points (a loop's) with it.
-void PlaceMap::scalePoints(int slot, double s, std::span<const Vec3> camera_centers) {
+void PlaceMap::scalePoints(int slot, double s, std::span<const Vec3> camera_centers, int cam) {
   PlacePoint* points = points_.data() + static_cast<std::size_t>(slot) * static_cast<std::size_t>(max_points_);
   const int32_t count = keyframes_[static_cast<std::size_t>(slot)].point_count;
   for (int i = 0; i < count; ++i) {
     PlacePoint& p = points[i];
+    if (cam >= 0 && p.cam != cam) continue;
     const bool known = p.cam >= 0 && static_cast<std::size_t>(p.cam) < camera_centers.size();
     const Eigen::Vector3f c = known ? Eigen::Vector3f(camera_centers[static_cast<std::size_t>(p.cam)].cast<float>())
                                     : Eigen::Vector3f::Zero();
     p.p_k = c + static_cast<float>(s) * (p.p_k - c);
   }
+}
+
+void PlaceMap::refinePose(int slot, const SE3& T_o_k) {
+  PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
+  const SE3 change = k.T_o_k.inverse() * T_o_k;
+  k.T_w_k = k.T_w_k * SE3(change.R, k.unit * change.t);
+  k.T_w_k.normalize();
+  k.T_o_k = T_o_k;
 }
 
 SE3 PlaceMap::toWorld(int32_t segment, const SE3& T_o_b) const {

@@ -1,5 +1,7 @@
 #include "mcslam/places/place_memory.hpp"
 
+#include "mcslam/places/loop_scale.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -22,6 +24,7 @@ PlaceMemory::PlaceMemory(const Rig& rig, const Vocabulary& vocabulary, const Pla
       camera_centers_(rig.cameraCenters()),
       landmark_stamp_(static_cast<std::size_t>(odometry_options.max_landmarks), -1),
       features_per_camera_(max_features_per_camera),
+      unrefined_(static_cast<std::size_t>(odometry_options.max_keyframes)),
       file_words_(options.max_words_per_keyframe),
       kept_ids_(2 * static_cast<std::size_t>(options.max_loops)),
       anchored_(PlaceMap::kMaxSegments, 0),
@@ -46,8 +49,10 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   if (!odometry.rescales().empty()) odometry.trackingRig().cameraCenters(camera_centers_);
   for (const Odometry::Rescale& r : odometry.rescales())
     map_.rescaleSegment(segment_, r.s, r.center, r.from_frame, camera_centers_);
-  if (!localize_only_)
+  if (!localize_only_) {
     for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
+    refinePoints(odometry);
+  }
   if (out.state == TrackingState::Tracking && out.valid) {  // the odometry's path, for the drift it can have
     if (have_last_position_) path_ += (out.T_w_b.t - last_position_).norm();
     last_position_ = out.T_w_b.t;
@@ -123,7 +128,6 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   const Map& local = odometry.map();
   const Keyframe& kf = local.keyframe(odometry_slot);
   const SE3 T_w_k = map_.toWorld(segment_, kf.T_w_b);
-  const double unit = map_.segmentScale(segment_);  // the place map's points are in the world's unit
   if (map_.size() == map_.capacity()) makeRoom();
   const int slot = map_.createKeyframe(segment_, kf.t, kf.frame_index, T_w_k, kf.T_w_b);
   if (slot < 0) {
@@ -131,33 +135,11 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
     return;
   }
   map_.setUnitSigma(slot, odometry.unitSigma());
-  const SE3 T_k_o = kf.T_w_b.inverse();
-  const int levels_up = words_.directLevelsUp();
   std::fill(own_points_.begin(), own_points_.end(), Eigen::Vector3f::Constant(std::nanf("")));
-  for (int c = 0; c < kf.features.cameras(); ++c) {
-    const auto& landmark_of = kf.landmark_of[static_cast<std::size_t>(c)];
-    for (int k = 0; k < kf.features.sets[static_cast<std::size_t>(c)].count; ++k) {
-      const int lm = landmark_of[static_cast<std::size_t>(k)];
-      if (lm < 0 || !local.landmark(lm).alive || landmark_stamp_[static_cast<std::size_t>(lm)] == kf.id) continue;
-      landmark_stamp_[static_cast<std::size_t>(lm)] = kf.id;
-      const Landmark& l = local.landmark(lm);
-      // Only points whose position is certain anchor a place: a multi-view point (depth to about 1%), or one the
-      // back-end has seen from three keyframes; a young point triangulated across two keyframes is only as good as the
-      // mapper's acceptance bound on its depth. (Odometry::startDeferredMapping relies on it: the new points of a
-      // keyframe made in this frame, seen from it and one earlier keyframe, may not exist yet.)
-      if (!l.metric && local.observingKeyframes(lm) < 3) continue;
-      PlacePoint p;
-      p.p_k = (unit * (T_k_o * l.p_w)).cast<float>();
-      own_points_[static_cast<std::size_t>(c * features_per_camera_ + k)] = p.p_k;
-      p.descriptor = l.descriptor;
-      p.node = vocabulary_.ancestor(vocabulary_.word(l.descriptor), levels_up);
-      p.cam = static_cast<int16_t>(c);
-      p.octave = kf.features.sets[static_cast<std::size_t>(c)].keypoints[static_cast<std::size_t>(k)].octave;
-      p.landmark_id = l.id + landmark_id_offset_;
-      if (!map_.addPoint(slot, p)) break;
-    }
-  }
-  map_.finishKeyframe(slot);
+  gatherPoints(local, kf, slot, own_points_);
+  // One camera's window lets its unit drift from one keyframe to the next: its points stay as they were made.
+  if (cameras_.size() > 1 && odometry.unitSigma() >= kUncertainUnit && unrefined_count_ < unrefined_.size())
+    unrefined_[unrefined_count_++] = {slot, odometry_slot, map_.keyframe(slot).id, kf.id};
   words_.compute(vocabulary_, kf.features);
   database_.insert(slot, words_.bow());
   ++stats_.keyframes;
@@ -170,6 +152,63 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
     loop_closer_.startDetection(slot, kf.features, words_, map_, database_, own_points_);
     if (options_.repeatable) collectLoopDetection(/*wait=*/true);
   }
+}
+
+void PlaceMemory::gatherPoints(const Map& local, const Keyframe& kf, int slot, std::span<Eigen::Vector3f> own) {
+  const SE3 T_k_o = kf.T_w_b.inverse();
+  const double unit = map_.segmentScale(map_.keyframe(slot).segment);  // the place map's points are in the world's unit
+  const int levels_up = words_.directLevelsUp();
+  ++gather_stamp_;
+  for (int c = 0; c < kf.features.cameras(); ++c) {
+    const auto& landmark_of = kf.landmark_of[static_cast<std::size_t>(c)];
+    for (int k = 0; k < kf.features.sets[static_cast<std::size_t>(c)].count; ++k) {
+      const int lm = landmark_of[static_cast<std::size_t>(k)];
+      if (lm < 0 || !local.landmark(lm).alive || landmark_stamp_[static_cast<std::size_t>(lm)] == gather_stamp_)
+        continue;
+      landmark_stamp_[static_cast<std::size_t>(lm)] = gather_stamp_;
+      const Landmark& l = local.landmark(lm);
+      // Only points whose position is certain anchor a place: a multi-view point (depth to about 1%), or one the
+      // back-end has seen from three keyframes; a young point triangulated across two keyframes is only as good as the
+      // mapper's acceptance bound on its depth. (Odometry::startDeferredMapping relies on it: the new points of a
+      // keyframe made in this frame, seen from it and one earlier keyframe, may not exist yet.)
+      if (!l.metric && local.observingKeyframes(lm) < 3) continue;
+      PlacePoint p;
+      p.p_k = (unit * (T_k_o * l.p_w)).cast<float>();
+      if (!own.empty()) own[static_cast<std::size_t>(c * features_per_camera_ + k)] = p.p_k;
+      p.descriptor = l.descriptor;
+      p.node = vocabulary_.ancestor(vocabulary_.word(l.descriptor), levels_up);
+      p.cam = static_cast<int16_t>(c);
+      p.octave = kf.features.sets[static_cast<std::size_t>(c)].keypoints[static_cast<std::size_t>(k)].octave;
+      p.landmark_id = l.id + landmark_id_offset_;
+      if (!map_.addPoint(slot, p)) break;
+    }
+  }
+  map_.finishKeyframe(slot);
+}
+
+// A place made while the unit was uncertain took its points from a young map: the start's, triangulated across its
+// short baselines (the first two keyframes of a start from two frames keep none), or one before its first scale
+// estimate. When its keyframe leaves the odometry's window, every keyframe of the window has refined them and its
+// pose: the place takes both then, so that its points and pose come from one estimate, as its neighbours' do.
+void PlaceMemory::refinePoints(const Odometry& odometry) {
+  const Map& local = odometry.map();
+  std::size_t waiting = 0;
+  for (std::size_t i = 0; i < unrefined_count_; ++i) {
+    const UnrefinedPlace u = unrefined_[i];
+    const Keyframe& kf = local.keyframe(u.odometry_slot);
+    const PlaceKeyframe& place = map_.keyframe(u.place_slot);
+    if (!kf.alive || kf.id != u.odometry_id || !place.alive || place.id != u.place_id) continue;  // gone
+    if (kf.in_backend) {
+      unrefined_[waiting++] = u;
+      continue;
+    }
+    collectLoopDetection(/*wait=*/true);  // it reads the points
+    map_.refinePose(u.place_slot, kf.T_w_b);
+    map_.clearPoints(u.place_slot);
+    gatherPoints(local, kf, u.place_slot, {});
+    ++stats_.places_refined;
+  }
+  unrefined_count_ = waiting;
 }
 
 void PlaceMemory::takeCorrection(bool wait) {
@@ -409,6 +448,7 @@ void PlaceMemory::readMap(std::string_view bytes, const std::string& name, bool 
   landmark_id_offset_ = last_landmark + 1;
   segment_ = -1;
   last_place_keyframe_ = -1;
+  unrefined_count_ = 0;
 }
 
 }  // namespace mcslam

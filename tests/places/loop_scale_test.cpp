@@ -100,6 +100,32 @@ TEST(LoopScale, EachPlaceKeyframesMatchesMeasureItsOwnUnit) {
   EXPECT_FALSE(at(5).ok);  // none of its points matched
 }
 
+// Before a rig without overlap knows its unit, its motion is in one unit and its lever arms in metres: each
+// camera's depths come out in a unit of their own, and each camera's matches measure it.
+TEST(LoopScale, EachCameraOfAPlaceMeasuresItsOwnUnit) {
+  const SE3 T_w_b;
+  Rig rig = oneCamera();
+  rig.cameras.push_back(rig.cameras[0]);  // a second camera at the same centre (scene() puts points about it)
+  Scene s = scene(80, 1.2, 0, 0.01, T_w_b, 7);
+  const Scene second = scene(50, 0.9, 0, 0.01, T_w_b, 8);
+  const int per_camera = 200;
+  s.own.resize(2 * per_camera, Eigen::Vector3f::Constant(std::nanf("")));
+  for (PlaceMatch m : second.inliers) {
+    m.cam = 1;
+    s.inliers.push_back(m);
+  }
+  std::copy(second.own.begin(), second.own.end(), s.own.begin() + per_camera);
+  for (PlaceMatch& m : s.inliers) m.keyframe = 4;
+  std::vector<double> scratch(512);
+  const auto of = [&](int cam) { return loopScale(s.inliers, s.own, per_camera, T_w_b, rig, scratch, 4, cam); };
+  EXPECT_NEAR(of(0).scale, 1.2, 0.01);
+  EXPECT_EQ(of(0).samples, 80);
+  EXPECT_NEAR(of(1).scale, 0.9, 0.01);
+  EXPECT_EQ(of(1).samples, 50);
+  const LoopScale both = loopScale(s.inliers, s.own, per_camera, T_w_b, rig, scratch, 4);
+  EXPECT_EQ(both.samples, 130);  // the keyframe's, all cameras
+}
+
 // A place made in a known unit takes any loop; one made while the unit was uncertain takes a loop only when the
 // keyframe, in a known unit itself, measures it in the same unit within the measurement's error.
 TEST(LoopScale, APlaceOfAnUncertainUnitTakesALoopOnlyInTheSameUnit) {

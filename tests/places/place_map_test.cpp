@@ -180,6 +180,45 @@ TEST(PlaceMap, APointScalesAlongTheRayOfTheCameraThatSawIt) {
   EXPECT_TRUE(map.points(slot)[0].p_k.isApprox(Eigen::Vector3f(0.3f, 0.f, 2.f)));
 }
 
+// A loop measured camera 1's points of a place in another unit: they take it along their rays, camera 0's stay,
+// and the place remembers which were measured until it takes its points anew.
+TEST(PlaceMap, AMeasuredUnitScalesOneCamerasPointsAndIsRemembered) {
+  Straight d = straight();
+  PlaceMap& map = d.map;
+  const int slot = map.createKeyframe(d.segment, 9, 200, SE3(), SE3());
+  PlacePoint front = pointAt(1, 90), side = pointAt(2, 91);
+  front.cam = 0;
+  side.cam = 1;
+  side.p_k = Eigen::Vector3f(0.3f, 0.f, 2.f);
+  map.addPoint(slot, front);
+  map.addPoint(slot, side);
+  map.finishKeyframe(slot);
+  const std::vector<Vec3> centers{Vec3::Zero(), Vec3(0.3, 0, 0.1)};
+  map.takeMeasuredUnit(slot, 1, 0.5, centers);
+  EXPECT_TRUE(map.points(slot)[0].p_k.isApprox(Eigen::Vector3f(1.f, 0.f, 1.f)));     // camera 0's: as it was
+  EXPECT_TRUE(map.points(slot)[1].p_k.isApprox(Eigen::Vector3f(0.3f, 0.f, 1.05f)));  // 0.1 + 0.5 (2 - 0.1)
+  EXPECT_EQ(map.keyframe(slot).cameras_unit_measured, uint64_t{2});
+  map.clearPoints(slot);
+  EXPECT_EQ(map.points(slot).size(), 0u);
+  EXPECT_EQ(map.keyframe(slot).cameras_unit_measured, uint64_t{0});
+}
+
+// The odometry refined a keyframe's pose after the place was made: the world pose takes the same change in the
+// keyframe's frame, on top of where a loop correction had put it.
+TEST(PlaceMap, ARefinedPoseKeepsWhatALoopMovedTheKeyframeBy) {
+  Straight d = straight();
+  PlaceMap& map = d.map;
+  const int slot = d.slots[2];
+  const SE3 corrected(so3Exp(Vec3(0, 0, M_PI / 2)), Vec3(5, 5, 0));
+  map.setKeyframePose(slot, corrected);
+  SE3 refined = map.keyframe(slot).T_o_k;
+  refined.t.x() += 0.2;
+  map.refinePose(slot, refined);
+  EXPECT_TRUE(map.keyframe(slot).T_o_k.t.isApprox(refined.t));
+  EXPECT_TRUE(map.keyframe(slot).T_w_k.t.isApprox(Vec3(5, 5.2, 0)));
+  EXPECT_TRUE(map.keyframe(slot).T_w_k.R.isApprox(corrected.R));
+}
+
 TEST(PlaceMap, ADriftedUnitIsRescaledFromTheEstimatesWindowOn) {
   Straight d = straight();
   const uint64_t reshapes = d.map.reshapes();

@@ -170,6 +170,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("relocalizations").value(p.relocalizations);
     j.key("segments").value(places->map().segments());  // odometry maps started, the first one included
     j.key("segments_reused").value(p.segments_reused);
+    j.key("places_refined").value(p.places_refined);  // places of an uncertain unit that took refined points
     j.key("last_relocalized_frame").value(static_cast<long long>(p.last_relocalized_frame));
     const LoopStats& l = places->loopStats();
     j.key("loop_queries").value(l.queries);
@@ -177,7 +178,8 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     j.key("loops_consistent").value(l.consistent);
     j.key("loop_closures").value(l.closures);
     j.key("map_merges").value(l.merges);
-    j.key("loop_places_rescaled").value(l.places_rescaled);  // a loop found a place's points in another unit
+    j.key("loop_places_rescaled").value(l.places_rescaled);  // a place camera's points took a unit a loop measured
+    j.key("loop_remeasured").value(l.remeasured);            // loops measured again on them at once
     j.key("loop_units_unmeasured").value(l.units_unmeasured);
     j.key("loop_queries_skipped").value(l.skipped);  // while a correction was being solved
     j.key("loop_detection_waits").value(l.waits);    // frames that waited for the detection thread (--live)

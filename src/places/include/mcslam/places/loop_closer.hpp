@@ -31,11 +31,12 @@ struct LoopStats {
   uint64_t skipped = 0;     // keyframes not queried: a correction was being solved
   uint64_t waits = 0;       // frames that had to wait for a detection to finish before writing the map
   uint64_t restarted = 0;   // corrections solved again: a segment was moved or rescaled during the solve
-  // Loops onto places made while the unit was uncertain (PlaceUnit): the place keyframes whose points a loop found
-  // in another unit and rescaled (that loop not closed), and the loops not closed because the recognizing
-  // keyframe's own unit was uncertain too.
+  // Loops onto places made while the unit was uncertain (PlaceUnit): the place keyframes' cameras whose points took
+  // the unit a loop measured on them, and the loops not closed because the recognizing keyframe's own unit was
+  // uncertain too.
   uint64_t places_rescaled = 0;
   uint64_t units_unmeasured = 0;
+  uint64_t remeasured = 0;  // loops measured again at once, on the places that took the keyframe's unit
   int64_t last_keyframe = -1, last_candidate = -1;  // place keyframe ids of the last closure
   double last_correction_m = 0, last_correction_deg = 0;
   double last_solve_ms = 0;
@@ -68,7 +69,8 @@ class LoopCloser {
   // Takes the result of the detection in flight, waiting for it with `wait` (otherwise only when it is ready), and
   // decides on it: true when it closed a loop, whose correction is then being solved; the map does not move until
   // takeCorrection(). `map` is the one the detection started on, unchanged; a loop onto places whose unit was
-  // uncertain may give their points the unit it measured (settlePlaceUnits).
+  // uncertain may give their points the unit it measured (settlePlaceUnits) and measure the loop again on them: with
+  // `wait` that is waited for too; without, it is in flight when this returns.
   bool collectDetection(PlaceMap& map, bool wait);
   // At a frame boundary: a correction solved since moves the map's keyframes and segments' frames (true). With
   // `wait`, one in flight is waited for; without, it is taken at the first call that finds it ready.
@@ -101,8 +103,14 @@ class LoopCloser {
   void detect();
   // What the detection found for keyframe `slot` decides whether it closes a loop (onto the processing thread).
   bool decide(int slot, const RelocalizationResult& found, PlaceMap& map);
-  // Whether the loop's places are in this keyframe's unit; those found in another take it (false then).
-  bool settlePlaceUnits(int slot, PlaceMap& map);
+  enum class PlaceUnits {
+    Agree,         // the loop's places are in this keyframe's unit, or their points took it within its error
+    Differ,        // some were in another: their points took this keyframe's unit, the loop's pose is off
+    Unmeasurable,  // some are of uncertain unit, and so is this keyframe
+  };
+  PlaceUnits settlePlaceUnits(int slot, PlaceMap& map);
+  // Starts measuring keyframe `slot`'s loop again (false: it was, or the map is being corrected).
+  bool remeasure(int slot);
   // The place keyframe (slot) of the verified group whose points hold the most inliers (the candidate first).
   int measuringPlace() const;
   bool followsLast(int slot, const PlaceMap& map) const;
@@ -140,6 +148,8 @@ class LoopCloser {
   // The detection in flight: its keyframe, the map and database it reads, copies of the keyframe's frame and words,
   // and what it found.
   int detect_slot_ = -1;
+  int64_t detect_keyframe_id_ = -1;
+  int64_t remeasured_keyframe_ = -1;  // the keyframe whose loop was last measured again (remeasure)
   const PlaceMap* detect_map_ = nullptr;
   const PlaceDatabase* detect_database_ = nullptr;
   FrameFeatures detect_features_;

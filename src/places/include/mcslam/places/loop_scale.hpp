@@ -26,9 +26,10 @@ struct LoopScale {
 
 // `own_points[cam * per_camera + kp]`: the keyframe's own point of that keypoint in its body frame, NaN where it has
 // none. `T_w_b`: the verified pose; `scratch` is sized by the caller (fixed memory): at most its size of the
-// inliers are used. `keyframe`: only the inliers of that place keyframe (slot, PlaceMatch::keyframe), or all (-1).
+// inliers are used. `keyframe`: only the inliers of that place keyframe (slot, PlaceMatch::keyframe), or all (-1);
+// `cam`: only those of that camera, or all (-1).
 LoopScale loopScale(std::span<const PlaceMatch> inliers, std::span<const Eigen::Vector3f> own_points, int per_camera,
-                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch, int keyframe = -1);
+                    const SE3& T_w_b, const Rig& rig, std::vector<double>& scratch, int keyframe = -1, int cam = -1);
 
 // A place made while the odometry's unit was uncertain (a rig without overlap, before its scale was found) has its
 // points in the unit of then, which the later rescales of the whole map brought only near the metric one: a pose

@@ -47,6 +47,9 @@ struct PlaceKeyframe {
   // (Odometry::unitSigma when it was made): 0 for a rig whose maps start metric. The loop closer's graph lets that
   // motion's length, not its direction, give way by this much.
   double unit_sigma = 0;
+  // Bit c: its points of camera c took the unit a loop measured on them (LoopCloser; only places of an uncertain
+  // unit_sigma are measured). Not in the map file: a run that loads the map measures them again, in its own unit.
+  uint64_t cameras_unit_measured = 0;
   int32_t previous = -1, next = -1;  // neighbours in its segment (slots)
   int32_t point_count = 0;
 };
@@ -89,9 +92,23 @@ class PlaceMap {
   // depth from the camera that saw it (`camera_centers`: each camera's centre in the body frame; a point of a camera
   // not in it scales about the body).
   void scaleKeyframe(int slot, double s, std::span<const Vec3> camera_centers);
-  // Keyframe `slot`'s points take a unit `s` times the one they were in (a loop measured it), as scaleKeyframe's;
-  // its pose and unit stay.
-  void scalePoints(int slot, double s, std::span<const Vec3> camera_centers);
+  // Keyframe `slot`'s points (of camera `cam`, or all: -1) take a unit `s` times the one they were in (a loop
+  // measured it), as scaleKeyframe's; its pose and unit stay.
+  void scalePoints(int slot, double s, std::span<const Vec3> camera_centers, int cam = -1);
+  // The odometry refined keyframe `slot`'s pose in its segment to T_o_k: its world pose takes the same change in its
+  // body frame (and keeps what loop corrections moved it by).
+  void refinePose(int slot, const SE3& T_o_k);
+  // Keyframe `slot` takes its points anew (addPoint, then finishKeyframe).
+  void clearPoints(int slot) {
+    keyframes_[static_cast<std::size_t>(slot)].point_count = 0;
+    keyframes_[static_cast<std::size_t>(slot)].cameras_unit_measured = 0;
+  }
+  // As scalePoints for camera `cam`'s points, for the unit a loop measured on them: marks them
+  // (PlaceKeyframe::cameras_unit_measured).
+  void takeMeasuredUnit(int slot, int cam, double s, std::span<const Vec3> camera_centers) {
+    scalePoints(slot, s, camera_centers, cam);
+    keyframes_[static_cast<std::size_t>(slot)].cameras_unit_measured |= uint64_t{1} << cam;
+  }
   // The segment's odometry took a new unit (positions p became center + s (p - center) in its frame) for the motion
   // since frame `from_frame`: the keyframes made from then on follow (their odometry and world poses, about the
   // center in either frame, and their points as scaleKeyframe's); those made before keep their poses, so that the

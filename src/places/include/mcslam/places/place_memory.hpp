@@ -35,6 +35,7 @@ struct PlaceStats {
   int64_t placed_frame = -1;               // with a reused map: the frame first recognized in it
   uint64_t localization_corrections = 0;   // localizing in a map: recognitions that moved the estimate
   uint64_t segments_reused = 0;            // all PlaceMap::kMaxSegments taken: an empty one made anew
+  uint64_t places_refined = 0;             // places of an uncertain unit that took their points again (refinePoints)
 };
 
 class PlaceMemory {
@@ -81,6 +82,11 @@ class PlaceMemory {
   void followSegment(const Odometry& odometry);
   int32_t reuseSegment(const SE3& T_w_o, bool placed);  // -1 when none can be
   void addKeyframe(const Odometry& odometry, int odometry_slot);
+  // Place keyframe `slot`'s points: those of odometry keyframe `kf` whose position is certain, in its body frame.
+  // `own` (empty, or cam * max features + kp): each keypoint's point, for a loop's scale.
+  void gatherPoints(const Map& local, const Keyframe& kf, int slot, std::span<Eigen::Vector3f> own);
+  // The places waiting for their keyframe to leave the odometry's window take their points then (refinePoints).
+  void refinePoints(const Odometry& odometry);
   void makeRoom();  // a full map lets its least needed keyframe go, keeping those loops join
   void relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);
   // The tracked frame recognized in the map's other segments places the run in the world, or (localizing in a
@@ -103,11 +109,20 @@ class PlaceMemory {
   LoopCloser loop_closer_;
   std::vector<MapSeed> seeds_;
   std::vector<Vec3> camera_centers_;  // in the body frame, as of the odometry's last rescale (PlaceMap::rescaleSegment)
-  std::vector<int64_t> landmark_stamp_;  // per odometry landmark slot: the keyframe id it was last added for
+  std::vector<int64_t> landmark_stamp_;  // per odometry landmark slot: the gather it was last added in
   // The last keyframe's own point of each keypoint (cam * max features + kp; NaN: none), for the scale of a loop
   // (LoopScale).
   std::vector<Eigen::Vector3f> own_points_;
   int features_per_camera_ = 0;
+  int64_t gather_stamp_ = 0;  // one per gatherPoints()
+  // Places of an uncertain unit whose keyframe is still in the odometry's window (refinePoints), by slot and id in
+  // either map; as many as the odometry's keyframe pool holds.
+  struct UnrefinedPlace {
+    int place_slot = -1, odometry_slot = -1;
+    int64_t place_id = -1, odometry_id = -1;
+  };
+  std::vector<UnrefinedPlace> unrefined_;
+  std::size_t unrefined_count_ = 0;
   int32_t segment_ = -1;
   uint64_t initializations_seen_ = 0;
   uint16_t world_revision_ = 0;

@@ -1,0 +1,76 @@
+// Places made while a rig without overlap was finding its unit take their points and pose again when their
+// keyframe leaves the odometry's window: the first two keyframes of its start from two frames, which had no
+// certain point when they were made, then hold points (a loop back to the start can be measured on them), and
+// taking them allocates nothing. Exact synthetic geometry (the odometry's own test sequence), no rendering.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "../odometry/synthetic_sequence.hpp"
+#include "alloc_testing.hpp"
+#include "mcslam/features/multiview_matcher.hpp"
+#include "mcslam/places/loop_scale.hpp"
+#include "mcslam/places/place_memory.hpp"
+#include "mcslam/recognition/vocabulary.hpp"
+
+namespace mcslam {
+namespace {
+
+// The place keyframe with this id, or nullptr.
+const PlaceKeyframe* placeOfId(const PlaceMap& map, int64_t id) {
+  for (int slot = 0; slot < map.capacity(); ++slot)
+    if (map.keyframe(slot).alive && map.keyframe(slot).id == id) return &map.keyframe(slot);
+  return nullptr;
+}
+
+TEST(PlaceRefinement, PlacesOfAnUncertainUnitTakeTheWindowsPointsWhenTheirKeyframeLeavesIt) {
+  const Rig rig = test::nonOverlappingRig3();
+  test::SyntheticSequenceOptions so;
+  so.frames = 100;
+  test::SyntheticSequence seq(rig, so);
+  OverlapMap overlap(rig, OverlapOptions{});
+  MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
+  const OdometryOptions odometry_options;
+  Odometry odometry(rig, odometry_options, so.max_features);
+  static const Vocabulary vocabulary = loadVocabulary("");
+  PlacesOptions places;
+  places.repeatable = true;
+  PlaceMemory memory(rig, vocabulary, places, odometry_options, so.max_features);
+  FrameFeatures frame(rig.size(), so.max_features);
+  int first_points_when_made = -1;  // of the map's first place keyframe, the frame it joined the place map
+  uint64_t allocations = 0;
+  for (int i = 0; i < seq.frames(); ++i) {
+    seq.fill(i, frame);
+    matcher.compute(frame);
+    PoseEstimate pose;
+    alloc::ThreadScope scope;
+    odometry.process(frame, static_cast<uint64_t>(i), pose);
+    memory.afterOdometry(frame, static_cast<uint64_t>(i), odometry, pose);
+    odometry.startDeferredMapping();
+    if (i >= so.warmup_frames) allocations += scope.count();
+    const PlaceKeyframe* first = placeOfId(memory.map(), 0);
+    if (first != nullptr && first_points_when_made < 0) first_points_when_made = first->point_count;
+  }
+  ASSERT_GE(odometry.stats().initializations, 1u);
+  EXPECT_EQ(odometry.stats().scale_converged_frame, -1) << "the unit should still be uncertain for this test";
+  EXPECT_EQ(first_points_when_made, 0) << "a start from two frames has no certain point yet";
+  const PlaceKeyframe* first = placeOfId(memory.map(), 0);
+  ASSERT_NE(first, nullptr);
+  EXPECT_GT(first->point_count, 50);
+  // Each made in an uncertain unit took them, but those still in the window (and the newest, not in it yet).
+  int uncertain = 0;
+  for (int slot = 0; slot < memory.map().capacity(); ++slot)
+    uncertain += memory.map().keyframe(slot).alive && memory.map().keyframe(slot).unit_sigma >= kUncertainUnit;
+  std::printf("place keyframes %d, %d of an uncertain unit, %llu refined\n", memory.map().size(), uncertain,
+              static_cast<unsigned long long>(memory.stats().places_refined));
+  const auto refined = static_cast<int>(memory.stats().places_refined);
+  EXPECT_LE(refined, uncertain);
+  EXPECT_GE(refined + odometry_options.window_keyframes + 1, uncertain);
+  EXPECT_GT(refined, 0);
+  if (test::countsAllocations()) {
+    EXPECT_EQ(allocations, 0u);
+  }
+}
+
+}  // namespace
+}  // namespace mcslam
