@@ -119,9 +119,9 @@ bool LoopCloser::decide(int slot, const RelocalizationResult& r, PlaceMap& map) 
     pending_keyframe_ = -1;
     return false;
   }
-  const PlaceUnits units = similarity() ? PlaceUnits::Agree : settlePlaceUnits(slot, map);
-  if (units == PlaceUnits::Differ && remeasure(slot)) return false;  // the last keyframe's detection stays pending
-  if (units != PlaceUnits::Agree) {
+  const GroupUnits units = similarity() ? GroupUnits::Agree : settlePlaceUnits(slot, map);
+  if (units == GroupUnits::Differ && remeasure(slot)) return false;  // the last keyframe's detection stays pending
+  if (units != GroupUnits::Agree) {
     pending_keyframe_ = -1;
     return false;
   }
@@ -215,23 +215,24 @@ void LoopCloser::startCorrection(const PlaceMap& map) {
 }
 
 // The verification matched the points of the candidate and its neighbours, each in the unit of its own time
-// (PlaceUnit). Each camera's points of a place of uncertain unit, not measured yet, are measured against this
-// keyframe's own points on their own matches and take the unit they measured: hundreds of depths know it better
-// than the odometry did. Per camera: before the unit was known, the motion was in one unit and the lever arms in
-// metres, so each camera's depths came out in a unit of their own. When one was off beyond the measurement's error,
-// so is the pose measured on it. A camera with too few matches of its own adds too little to the pose to decide.
-LoopCloser::PlaceUnits LoopCloser::settlePlaceUnits(int slot, PlaceMap& map) {
+// (PlaceUnit). Each camera's points of a place of uncertain unit are measured against this keyframe's own points
+// on their own matches and take the unit they measured: hundreds of depths know it better than the odometry did.
+// Per camera: before the unit was known, the motion was in one unit and the lever arms in metres, so each camera's
+// depths came out in a unit of their own. When one was off beyond the measurement's error, so is the pose measured
+// on it; once a measurement agrees with them, they are settled. A camera with too few matches of its own adds too
+// little to the pose to decide.
+LoopCloser::GroupUnits LoopCloser::settlePlaceUnits(int slot, PlaceMap& map) {
   const double own_sigma = map.keyframe(slot).unit_sigma;
-  const int cameras = verifier_.rig().size();
-  PlaceUnits units = PlaceUnits::Agree;
+  const int cameras = std::min(verifier_.rig().size(), 64);  // PlaceKeyframe::cameras_unit_measured's bits
+  GroupUnits units = GroupUnits::Agree;
   for (const int32_t g : verifier_.group()) {
     const PlaceKeyframe& place = map.keyframe(g);
     if (place.unit_sigma < kUncertainUnit) continue;
     for (int cam = 0; cam < cameras; ++cam) {
-      if (place.cameras_unit_measured & (uint64_t{1} << cam)) continue;
+      if ((place.cameras_unit_measured & (uint64_t{1} << cam)) || !matched(g, cam)) continue;
       if (own_sigma >= kUncertainUnit) {  // nothing surer to measure it with
         ++stats_.units_unmeasured;
-        return PlaceUnits::Unmeasurable;
+        return GroupUnits::Unmeasurable;
       }
       const LoopScale own = loopScale(verifier_.inliers(), detect_own_points_, features_per_camera_, found_.T_w_b,
                                       verifier_.rig(), scale_scratch_, g, cam);
@@ -241,18 +242,28 @@ LoopCloser::PlaceUnits LoopCloser::settlePlaceUnits(int slot, PlaceMap& map) {
           "place memory: keyframe {} finds camera {}'s points of keyframe {} {:.4f} +- {:.4f} times as far as its "
           "own ({} points): they take its unit",
           map.keyframe(slot).id, cam, place.id, own.scale, own.sigma_log_scale, own.samples);
-      map.takeMeasuredUnit(g, cam, 1 / own.scale, camera_centers_);
       ++stats_.places_rescaled;
-      if (unit == PlaceUnit::Other) units = PlaceUnits::Differ;
+      if (unit == PlaceUnit::Other) {
+        map.scalePoints(g, 1 / own.scale, camera_centers_, cam);
+        units = GroupUnits::Differ;
+      } else {
+        map.takeMeasuredUnit(g, cam, 1 / own.scale, camera_centers_);
+      }
     }
   }
   return units;
 }
 
+bool LoopCloser::matched(int place, int cam) const {
+  for (const PlaceMatch& m : verifier_.inliers())
+    if (m.keyframe == place && m.cam == cam) return true;
+  return false;
+}
+
 // The loop is measured again, on the detection thread, on the points that took the keyframe's unit: once per
-// keyframe, unless a correction is about to move the map.
+// keyframe. (decide()'s result is the detection's own, which the new one overwrites.)
 bool LoopCloser::remeasure(int slot) {
-  if (remeasured_keyframe_ == detect_keyframe_id_ || correcting()) return false;
+  if (remeasured_keyframe_ == detect_keyframe_id_) return false;
   remeasured_keyframe_ = detect_keyframe_id_;
   ++stats_.remeasured;
   detect_slot_ = slot;

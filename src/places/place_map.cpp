@@ -156,6 +156,7 @@ void PlaceMap::scalePoints(int slot, double s, std::span<const Vec3> camera_cent
 }
 
 void PlaceMap::refinePose(int slot, const SE3& T_o_k) {
+  ++reshapes_;  // a correction solved from the pose before would put it back
   PlaceKeyframe& k = keyframes_[static_cast<std::size_t>(slot)];
   const SE3 change = k.T_o_k.inverse() * T_o_k;
   k.T_w_k = k.T_w_k * SE3(change.R, k.unit * change.t);

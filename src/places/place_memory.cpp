@@ -1,11 +1,11 @@
 #include "mcslam/places/place_memory.hpp"
 
-#include "mcslam/places/loop_scale.hpp"
-
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
+
+#include "mcslam/places/loop_scale.hpp"
 
 namespace mcslam {
 
@@ -50,8 +50,8 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   for (const Odometry::Rescale& r : odometry.rescales())
     map_.rescaleSegment(segment_, r.s, r.center, r.from_frame, camera_centers_);
   if (!localize_only_) {
+    refinePlaces(odometry);  // before a loop of this frame's keyframes starts a correction from their poses
     for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
-    refinePoints(odometry);
   }
   if (out.state == TrackingState::Tracking && out.valid) {  // the odometry's path, for the drift it can have
     if (have_last_position_) path_ += (out.T_w_b.t - last_position_).norm();
@@ -103,8 +103,8 @@ void PlaceMemory::followSegment(const Odometry& odometry) {
 
 bool PlaceMemory::onlyReadsMap(const Odometry& odometry, const PoseEstimate& out) const {
   return out.state == TrackingState::Tracking && odometry.stats().initializations == initializations_seen_ &&
-         odometry.rescales().empty() && odometry.settledKeyframes().empty() && segment_ >= 0 && map_.placed(segment_) &&
-         !localize_only_;
+         odometry.rescales().empty() && odometry.settledKeyframes().empty() && !refinementDue(odometry) &&
+         segment_ >= 0 && map_.placed(segment_) && !localize_only_;
 }
 
 void PlaceMemory::collectLoopDetection(bool wait) { loop_closer_.collectDetection(map_, wait); }
@@ -138,7 +138,9 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   std::fill(own_points_.begin(), own_points_.end(), Eigen::Vector3f::Constant(std::nanf("")));
   gatherPoints(local, kf, slot, own_points_);
   // One camera's window lets its unit drift from one keyframe to the next: its points stay as they were made.
-  if (cameras_.size() > 1 && odometry.unitSigma() >= kUncertainUnit && unrefined_count_ < unrefined_.size())
+  // (Each entry names a live keyframe of the odometry's pool, which has room for them all.)
+  if (cameras_.size() > 1 && odometry.unitSigma() >= kUncertainUnit && kf.in_backend &&
+      unrefined_count_ < unrefined_.size())
     unrefined_[unrefined_count_++] = {slot, odometry_slot, map_.keyframe(slot).id, kf.id};
   words_.compute(vocabulary_, kf.features);
   database_.insert(slot, words_.bow());
@@ -156,7 +158,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
 
 void PlaceMemory::gatherPoints(const Map& local, const Keyframe& kf, int slot, std::span<Eigen::Vector3f> own) {
   const SE3 T_k_o = kf.T_w_b.inverse();
-  const double unit = map_.segmentScale(map_.keyframe(slot).segment);  // the place map's points are in the world's unit
+  const double unit = map_.keyframe(slot).unit;  // the place map's points are in the world's unit
   const int levels_up = words_.directLevelsUp();
   ++gather_stamp_;
   for (int c = 0; c < kf.features.cameras(); ++c) {
@@ -190,14 +192,13 @@ void PlaceMemory::gatherPoints(const Map& local, const Keyframe& kf, int slot, s
 // short baselines (the first two keyframes of a start from two frames keep none), or one before its first scale
 // estimate. When its keyframe leaves the odometry's window, every keyframe of the window has refined them and its
 // pose: the place takes both then, so that its points and pose come from one estimate, as its neighbours' do.
-void PlaceMemory::refinePoints(const Odometry& odometry) {
+void PlaceMemory::refinePlaces(const Odometry& odometry) {
   const Map& local = odometry.map();
   std::size_t waiting = 0;
   for (std::size_t i = 0; i < unrefined_count_; ++i) {
     const UnrefinedPlace u = unrefined_[i];
+    if (!stillUnrefined(local, u)) continue;  // gone
     const Keyframe& kf = local.keyframe(u.odometry_slot);
-    const PlaceKeyframe& place = map_.keyframe(u.place_slot);
-    if (!kf.alive || kf.id != u.odometry_id || !place.alive || place.id != u.place_id) continue;  // gone
     if (kf.in_backend) {
       unrefined_[waiting++] = u;
       continue;
@@ -209,6 +210,18 @@ void PlaceMemory::refinePoints(const Odometry& odometry) {
     ++stats_.places_refined;
   }
   unrefined_count_ = waiting;
+}
+
+bool PlaceMemory::stillUnrefined(const Map& local, const UnrefinedPlace& u) const {
+  const Keyframe& kf = local.keyframe(u.odometry_slot);
+  const PlaceKeyframe& place = map_.keyframe(u.place_slot);
+  return kf.alive && kf.id == u.odometry_id && place.alive && place.id == u.place_id;
+}
+
+bool PlaceMemory::refinementDue(const Odometry& odometry) const {
+  for (std::size_t i = 0; i < unrefined_count_; ++i)
+    if (!odometry.map().keyframe(unrefined_[i].odometry_slot).in_backend) return true;
+  return false;
 }
 
 void PlaceMemory::takeCorrection(bool wait) {

@@ -204,19 +204,22 @@ TEST(PlaceMap, AMeasuredUnitScalesOneCamerasPointsAndIsRemembered) {
 }
 
 // The odometry refined a keyframe's pose after the place was made: the world pose takes the same change in the
-// keyframe's frame, on top of where a loop correction had put it.
+// keyframe's frame (its translation in the keyframe's unit, here 2 world units per odometry unit), on top of where
+// a loop correction had put it; a correction being solved from the pose before is stale.
 TEST(PlaceMap, ARefinedPoseKeepsWhatALoopMovedTheKeyframeBy) {
-  Straight d = straight();
-  PlaceMap& map = d.map;
-  const int slot = d.slots[2];
+  PlaceMap map(4, 4);
+  const int32_t segment = map.createSegment(SE3());
+  map.setSegmentScale(segment, 2.0);
+  const int slot = map.createKeyframe(segment, 0, 100, SE3(), SE3());
   const SE3 corrected(so3Exp(Vec3(0, 0, M_PI / 2)), Vec3(5, 5, 0));
   map.setKeyframePose(slot, corrected);
-  SE3 refined = map.keyframe(slot).T_o_k;
-  refined.t.x() += 0.2;
-  map.refinePose(slot, refined);
-  EXPECT_TRUE(map.keyframe(slot).T_o_k.t.isApprox(refined.t));
-  EXPECT_TRUE(map.keyframe(slot).T_w_k.t.isApprox(Vec3(5, 5.2, 0)));
-  EXPECT_TRUE(map.keyframe(slot).T_w_k.R.isApprox(corrected.R));
+  const SE3 change(so3Exp(Vec3(0, 0.1, 0)), Vec3(0.2, 0, 0));
+  const uint64_t reshapes = map.reshapes();
+  map.refinePose(slot, change);
+  EXPECT_TRUE(map.keyframe(slot).T_o_k.t.isApprox(change.t));
+  EXPECT_TRUE(map.keyframe(slot).T_w_k.t.isApprox(Vec3(5, 5.4, 0)));  // R_z(90) (0.4, 0, 0)
+  EXPECT_TRUE(map.keyframe(slot).T_w_k.R.isApprox(corrected.R * change.R));
+  EXPECT_GT(map.reshapes(), reshapes);
 }
 
 TEST(PlaceMap, ADriftedUnitIsRescaledFromTheEstimatesWindowOn) {

@@ -16,6 +16,24 @@
 namespace mcslam {
 namespace {
 
+// Compares each place of an uncertain unit whose odometry keyframe has left the window with that keyframe: it took
+// its pose (the odometry keeps it once out of the window). Returns how many it compared.
+int expectRefinedPoses(const PlaceMap& places, const Map& local) {
+  int compared = 0;
+  for (int k = 0; k < local.keyframeCapacity(); ++k) {
+    const Keyframe& kf = local.keyframe(k);
+    if (!kf.alive || kf.in_backend) continue;
+    for (int slot = 0; slot < places.capacity(); ++slot) {
+      const PlaceKeyframe& place = places.keyframe(slot);
+      if (!place.alive || place.frame_index != kf.frame_index || place.unit_sigma < kUncertainUnit) continue;
+      EXPECT_LT((place.T_o_k.t - kf.T_w_b.t).norm(), 1e-9) << "place keyframe " << place.id;
+      EXPECT_LT(rotationAngle(place.T_o_k.R, kf.T_w_b.R), 1e-9) << "place keyframe " << place.id;
+      ++compared;
+    }
+  }
+  return compared;
+}
+
 // The place keyframe with this id, or nullptr.
 const PlaceKeyframe* placeOfId(const PlaceMap& map, int64_t id) {
   for (int slot = 0; slot < map.capacity(); ++slot)
@@ -27,6 +45,7 @@ TEST(PlaceRefinement, PlacesOfAnUncertainUnitTakeTheWindowsPointsWhenTheirKeyfra
   const Rig rig = test::nonOverlappingRig3();
   test::SyntheticSequenceOptions so;
   so.frames = 100;
+  so.warmup_frames = 30;  // the refinements come within the first 60 frames
   test::SyntheticSequence seq(rig, so);
   OverlapMap overlap(rig, OverlapOptions{});
   MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
@@ -37,17 +56,20 @@ TEST(PlaceRefinement, PlacesOfAnUncertainUnitTakeTheWindowsPointsWhenTheirKeyfra
   places.repeatable = true;
   PlaceMemory memory(rig, vocabulary, places, odometry_options, so.max_features);
   FrameFeatures frame(rig.size(), so.max_features);
-  int first_points_when_made = -1;  // of the map's first place keyframe, the frame it joined the place map
-  uint64_t allocations = 0;
+  int first_points_when_made = -1;  // of the map's first place keyframe, in the frame it joined the place map
+  uint64_t allocations = 0, refined_in_warm_up = 0;
+  int compared = 0;
   for (int i = 0; i < seq.frames(); ++i) {
     seq.fill(i, frame);
     matcher.compute(frame);
     PoseEstimate pose;
+    if (i == so.warmup_frames) refined_in_warm_up = memory.stats().places_refined;
     alloc::ThreadScope scope;
     odometry.process(frame, static_cast<uint64_t>(i), pose);
     memory.afterOdometry(frame, static_cast<uint64_t>(i), odometry, pose);
     odometry.startDeferredMapping();
     if (i >= so.warmup_frames) allocations += scope.count();
+    compared += expectRefinedPoses(memory.map(), odometry.map());
     const PlaceKeyframe* first = placeOfId(memory.map(), 0);
     if (first != nullptr && first_points_when_made < 0) first_points_when_made = first->point_count;
   }
@@ -67,6 +89,8 @@ TEST(PlaceRefinement, PlacesOfAnUncertainUnitTakeTheWindowsPointsWhenTheirKeyfra
   EXPECT_LE(refined, uncertain);
   EXPECT_GE(refined + odometry_options.window_keyframes + 1, uncertain);
   EXPECT_GT(refined, 0);
+  EXPECT_GT(compared, 0);
+  EXPECT_GT(memory.stats().places_refined, refined_in_warm_up) << "the allocation count should cover a refinement";
   if (test::countsAllocations()) {
     EXPECT_EQ(allocations, 0u);
   }

@@ -29,7 +29,7 @@ struct LoopStats {
   uint64_t closures = 0;    // accepted: the map was corrected
   uint64_t merges = 0;      // closures that joined two segments
   uint64_t skipped = 0;     // keyframes not queried: a correction was being solved
-  uint64_t waits = 0;       // frames that had to wait for a detection to finish before writing the map
+  uint64_t waits = 0;       // detections a frame had to wait for before writing the map
   uint64_t restarted = 0;   // corrections solved again: a segment was moved or rescaled during the solve
   // Loops onto places made while the unit was uncertain (PlaceUnit): the place keyframes' cameras whose points took
   // the unit a loop measured on them, and the loops not closed because the recognizing keyframe's own unit was
@@ -103,13 +103,14 @@ class LoopCloser {
   void detect();
   // What the detection found for keyframe `slot` decides whether it closes a loop (onto the processing thread).
   bool decide(int slot, const RelocalizationResult& found, PlaceMap& map);
-  enum class PlaceUnits {
+  enum class GroupUnits {
     Agree,         // the loop's places are in this keyframe's unit, or their points took it within its error
-    Differ,        // some were in another: their points took this keyframe's unit, the loop's pose is off
+    Differ,        // some were in another: their points took the measured unit, the loop's pose is off
     Unmeasurable,  // some are of uncertain unit, and so is this keyframe
   };
-  PlaceUnits settlePlaceUnits(int slot, PlaceMap& map);
-  // Starts measuring keyframe `slot`'s loop again (false: it was, or the map is being corrected).
+  GroupUnits settlePlaceUnits(int slot, PlaceMap& map);
+  bool matched(int place, int cam) const;  // an inlier of the last verification is camera `cam`'s of `place`
+  // Starts measuring keyframe `slot`'s loop again (false: it was already).
   bool remeasure(int slot);
   // The place keyframe (slot) of the verified group whose points hold the most inliers (the candidate first).
   int measuringPlace() const;

@@ -98,7 +98,7 @@ class PlaceMap {
   // The odometry refined keyframe `slot`'s pose in its segment to T_o_k: its world pose takes the same change in its
   // body frame (and keeps what loop corrections moved it by).
   void refinePose(int slot, const SE3& T_o_k);
-  // Keyframe `slot` takes its points anew (addPoint, then finishKeyframe).
+  // Keyframe `slot` takes its points anew (addPoint, then finishKeyframe), none of them measured.
   void clearPoints(int slot) {
     keyframes_[static_cast<std::size_t>(slot)].point_count = 0;
     keyframes_[static_cast<std::size_t>(slot)].cameras_unit_measured = 0;
@@ -107,7 +107,7 @@ class PlaceMap {
   // (PlaceKeyframe::cameras_unit_measured).
   void takeMeasuredUnit(int slot, int cam, double s, std::span<const Vec3> camera_centers) {
     scalePoints(slot, s, camera_centers, cam);
-    keyframes_[static_cast<std::size_t>(slot)].cameras_unit_measured |= uint64_t{1} << cam;
+    if (cam >= 0 && cam < 64) keyframes_[static_cast<std::size_t>(slot)].cameras_unit_measured |= uint64_t{1} << cam;
   }
   // The segment's odometry took a new unit (positions p became center + s (p - center) in its frame) for the motion
   // since frame `from_frame`: the keyframes made from then on follow (their odometry and world poses, about the

@@ -35,7 +35,7 @@ struct PlaceStats {
   int64_t placed_frame = -1;               // with a reused map: the frame first recognized in it
   uint64_t localization_corrections = 0;   // localizing in a map: recognitions that moved the estimate
   uint64_t segments_reused = 0;            // all PlaceMap::kMaxSegments taken: an empty one made anew
-  uint64_t places_refined = 0;             // places of an uncertain unit that took their points again (refinePoints)
+  uint64_t places_refined = 0;             // places of an uncertain unit that took their points and pose again
 };
 
 class PlaceMemory {
@@ -73,10 +73,17 @@ class PlaceMemory {
   bool mapLoaded() const { return loaded_; }
 
  private:
+  // A place of an uncertain unit whose keyframe is still in the odometry's window (refinePlaces), by slot and id in
+  // either map.
+  struct UnrefinedPlace {
+    int place_slot = -1, odometry_slot = -1;
+    int64_t place_id = -1, odometry_id = -1;
+  };
+
   // A loop correction solved since the last frame moves the map (PlacesOptions::repeatable: waiting for it).
   void takeCorrection(bool wait);
   // This frame (the odometry's output) writes neither the place map nor the database: it only tracked, in a placed
-  // segment, and settled, rescaled and began nothing.
+  // segment, and settled, rescaled, began and refined nothing.
   bool onlyReadsMap(const Odometry& odometry, const PoseEstimate& out) const;
   void collectLoopDetection(bool wait);
   void followSegment(const Odometry& odometry);
@@ -85,8 +92,10 @@ class PlaceMemory {
   // Place keyframe `slot`'s points: those of odometry keyframe `kf` whose position is certain, in its body frame.
   // `own` (empty, or cam * max features + kp): each keypoint's point, for a loop's scale.
   void gatherPoints(const Map& local, const Keyframe& kf, int slot, std::span<Eigen::Vector3f> own);
-  // The places waiting for their keyframe to leave the odometry's window take their points then (refinePoints).
-  void refinePoints(const Odometry& odometry);
+  // The places waiting for their keyframe to leave the odometry's window take its points and pose then.
+  void refinePlaces(const Odometry& odometry);
+  bool refinementDue(const Odometry& odometry) const;  // a waiting place's keyframe has left the window
+  bool stillUnrefined(const Map& local, const UnrefinedPlace& u) const;  // both keyframes still there
   void makeRoom();  // a full map lets its least needed keyframe go, keeping those loops join
   void relocalize(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);
   // The tracked frame recognized in the map's other segments places the run in the world, or (localizing in a
@@ -114,14 +123,8 @@ class PlaceMemory {
   // (LoopScale).
   std::vector<Eigen::Vector3f> own_points_;
   int features_per_camera_ = 0;
-  int64_t gather_stamp_ = 0;  // one per gatherPoints()
-  // Places of an uncertain unit whose keyframe is still in the odometry's window (refinePoints), by slot and id in
-  // either map; as many as the odometry's keyframe pool holds.
-  struct UnrefinedPlace {
-    int place_slot = -1, odometry_slot = -1;
-    int64_t place_id = -1, odometry_id = -1;
-  };
-  std::vector<UnrefinedPlace> unrefined_;
+  int64_t gather_stamp_ = 0;               // one per gatherPoints()
+  std::vector<UnrefinedPlace> unrefined_;  // waiting for their keyframe to leave the window; fixed capacity
   std::size_t unrefined_count_ = 0;
   int32_t segment_ = -1;
   uint64_t initializations_seen_ = 0;
