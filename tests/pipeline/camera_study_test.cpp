@@ -71,9 +71,13 @@ TEST_F(CameraStudy, RepeatsSpreadTheFeatureCountAndTheMiddleRunIsThePlainRun) {
               std::string::npos)
         << f;
   }
-  // One table row for the configuration, with its runs and their feature range.
+  // One table row for the configuration, with its runs and their feature range; each run's loop-corrected
+  // keyframes are evaluated too.
   const std::string table = readFile(out_dir + "/study.md");
   EXPECT_EQ(count(table, "| seq | stereo | 0,1 | 3 (950-1050) | "), 1) << table;
+  EXPECT_EQ(count(table, "keyframes ATE (m), mean (min-max); runs with a loop closure"), 1) << table;
+  EXPECT_EQ(count(json, "\"keyframes_ate_m\": "), 3) << json;
+  EXPECT_FALSE(readFile(out_dir + "/seq_stereo_f1000_keyframes.tum").empty());
 
   // The run at the configured count is mcslam-run on defaults, pose for pose.
   const std::string plain = dir_->file("plain.tum");

@@ -6,8 +6,10 @@ the accuracy (ATE, evo conventions through mcslam-eval) and the cost, like the p
       --config "5 OV=0,1,2,3,4" --config "stereo=1,2" --config "mono=2:sim3" [--slam-config FILE] --out OUT
 
 Each --config is NAME=CAMERAS[:ALIGN]; ALIGN is se3 (default) or sim3 (one camera: scale is arbitrary).
-For every configuration the Sim(3) scale is also reported (1.0 = metric). Writes OUT/study.md (a
-Markdown table), OUT/study.json and, per run, the trajectory, the stats and a top-view plot.
+For every configuration the Sim(3) scale is also reported (1.0 = metric). The ATE is that of every frame's pose
+as it was published (a loop closure's correction makes the poses after it jump); "keyframes ATE" is that of the
+final, loop-corrected keyframe trajectory (mcslam-run --keyframes), under the same alignment. Writes OUT/study.md
+(a Markdown table), OUT/study.json and, per run, the trajectories, the stats and a top-view plot.
 
 --repeats N runs every configuration N times with the feature capacity per camera spread evenly over +-5% of
 the configured one (N = 7 at 1000: 950, 967, ..., 1050) and reports the mean ATE with its range. One run cannot
@@ -80,9 +82,10 @@ def run_once(args, dataset, seq, name, cams, align, features, repeats, config_te
     the repeats (None for a single run)."""
     tag = f"{seq}_{name}".replace(" ", "_").replace("/", "_") + (f"_f{features}" if repeats > 1 else "")
     traj = os.path.join(args.out, tag + ".tum")
+    keyframes = os.path.join(args.out, tag + "_keyframes.tum")
     stats_path = os.path.join(args.out, tag + "_stats.json")
     cmd = [os.path.join(args.bin, "mcslam-run"), "--dataset", dataset, "--cameras", cams, "--out", traj,
-           "--stats", stats_path, "--quiet"]
+           "--keyframes", keyframes, "--stats", stats_path, "--quiet"]
     if repeats > 1:
         cmd += ["--config", write_variant(config_text, features, os.path.join(args.out, tag + ".yaml"))]
     elif args.slam_config:
@@ -94,10 +97,12 @@ def run_once(args, dataset, seq, name, cams, align, features, repeats, config_te
         stats = json.load(f)
     ape = evaluate(args.bin, dataset, traj, align, os.path.join(args.out, tag + ".png"))
     scale = evaluate(args.bin, dataset, traj, "sim3")["scale"]
+    keyframes_ate = evaluate(args.bin, dataset, keyframes, align)["rmse"]
     states = stats["tracking_states"]
     r = {
         "sequence": seq, "config": name, "cameras": cams, "align": align, "features_per_camera": features,
         "ate_m": ape["rmse"], "ate_percent": ape["rmse_percent"], "path_m": ape["path_length"],
+        "keyframes_ate_m": keyframes_ate, "loop_closures": stats.get("places", {}).get("loop_closures", 0),
         "sim3_scale": scale, "frames": stats["frames"], "tracking": states["tracking"],
         "lost": states["lost"], "not_initialized": states["not_initialized"],
         "keyframes": stats["keyframes"], "ms_mean": stats["timing_ms"]["total"]["mean"],
@@ -105,19 +110,22 @@ def run_once(args, dataset, seq, name, cams, align, features, repeats, config_te
         # poses whose unit is not metres: one camera, or a rig without overlap before its scale is found
         "unscaled": stats.get("scale", {}).get("frames_unknown_scale", 0),
     }
-    print(f"  ATE {r['ate_m']:.4f} m ({r['ate_percent']:.3f} %), scale {r['sim3_scale']:.4f}, "
-          f"lost {r['lost']}, {r['ms_mean']:.1f} ms/frame", file=sys.stderr, flush=True)
+    print(f"  ATE {r['ate_m']:.4f} m ({r['ate_percent']:.3f} %), keyframes {r['keyframes_ate_m']:.4f} m, "
+          f"scale {r['sim3_scale']:.4f}, {r['loop_closures']} loop closures, lost {r['lost']}, "
+          f"{r['ms_mean']:.1f} ms/frame", file=sys.stderr, flush=True)
     return r
 
 
 def table_single(rows):
-    lines = ["| sequence | configuration | cameras | ATE (m) | ATE (% of path) | path (m) | Sim(3) scale | "
-             "frames tracked / lost / before init | poses up to scale | keyframes | ms per frame (mean / p99) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| sequence | configuration | cameras | ATE (m) | ATE (% of path) | path (m) | keyframes ATE (m), "
+             "loop closures | Sim(3) scale | frames tracked / lost / before init | poses up to scale | keyframes | "
+             "ms per frame (mean / p99) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         ate = f"{r['ate_m']:.4f}" + (" (Sim3)" if r["align"] == "sim3" else "")
         lines.append(f"| {r['sequence']} | {r['config']} | {r['cameras']} | {ate} | {r['ate_percent']:.3f} | "
-                     f"{r['path_m']:.1f} | {r['sim3_scale']:.4f} | {r['tracking']} / {r['lost']} / "
+                     f"{r['path_m']:.1f} | {r['keyframes_ate_m']:.4f}, {r['loop_closures']} | "
+                     f"{r['sim3_scale']:.4f} | {r['tracking']} / {r['lost']} / "
                      f"{r['not_initialized']} | {r['unscaled']} | {r['keyframes']} | {r['ms_mean']:.1f} / "
                      f"{r['ms_p99']:.1f} |")
     return lines
@@ -126,19 +134,23 @@ def table_single(rows):
 def table_repeated(groups):
     """One line per configuration: means over its repeats, with the range where a single run would mislead."""
     lines = ["| sequence | configuration | cameras | runs (features per camera) | ATE (m), mean (min-max) | "
-             "ATE (% of path), mean | Sim(3) scale, mean (min-max) | frames lost, all runs | "
-             "poses up to scale, mean | keyframes, mean | ms per frame, mean |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "ATE (% of path), mean | keyframes ATE (m), mean (min-max); runs with a loop closure | "
+             "Sim(3) scale, mean (min-max) | frames lost, all runs | poses up to scale, mean | keyframes, mean | "
+             "ms per frame, mean |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for g in groups:
         n = len(g)
         mean = lambda key: sum(r[key] for r in g) / n
         ates = [r["ate_m"] for r in g]
         scales = [r["sim3_scale"] for r in g]
+        keyframe_ates = [r["keyframes_ate_m"] for r in g]
+        closed = sum(1 for r in g if r["loop_closures"] > 0)
         r0 = g[0]
         lines.append(f"| {r0['sequence']} | {r0['config']} | {r0['cameras']} | {n} ({g[0]['features_per_camera']}-"
                      f"{g[-1]['features_per_camera']}) | {mean('ate_m'):.4f} ({min(ates):.4f}-{max(ates):.4f})"
                      + (" (Sim3)" if r0["align"] == "sim3" else "")
-                     + f" | {mean('ate_percent'):.3f} | {mean('sim3_scale'):.4f} ({min(scales):.4f}-{max(scales):.4f})"
+                     + f" | {mean('ate_percent'):.3f} | {mean('keyframes_ate_m'):.4f} ({min(keyframe_ates):.4f}-"
+                     f"{max(keyframe_ates):.4f}); {closed} | {mean('sim3_scale'):.4f} ({min(scales):.4f}-{max(scales):.4f})"
                      f" | {sum(r['lost'] for r in g)} | {mean('unscaled'):.0f} | {mean('keyframes'):.0f} | "
                      f"{mean('ms_mean'):.1f} |")
     return lines
