@@ -219,8 +219,11 @@ bool PlaceMemory::stillUnrefined(const Map& local, const UnrefinedPlace& u) cons
 }
 
 bool PlaceMemory::refinementDue(const Odometry& odometry) const {
-  for (std::size_t i = 0; i < unrefined_count_; ++i)
-    if (!odometry.map().keyframe(unrefined_[i].odometry_slot).in_backend) return true;
+  const Map& local = odometry.map();
+  for (std::size_t i = 0; i < unrefined_count_; ++i) {
+    const UnrefinedPlace& u = unrefined_[i];
+    if (!stillUnrefined(local, u) || !local.keyframe(u.odometry_slot).in_backend) return true;
+  }
   return false;
 }
 
