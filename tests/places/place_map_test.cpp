@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <vector>
 #include "alloc_testing.hpp"
 
@@ -146,6 +147,25 @@ Straight straight() {
   return d;
 }
 
+// A two-camera rig's centres: camera 1 sits 0.3 m to the side of the body and 0.1 m ahead.
+const std::vector<Vec3> kTwoCameraCentres{Vec3::Zero(), Vec3(0.3, 0, 0.1)};
+
+// A point camera 1 of that rig saw, 1.9 m ahead of it.
+PlacePoint sidePoint(int32_t node, int64_t landmark) {
+  PlacePoint p = pointAt(node, landmark);
+  p.cam = 1;
+  p.p_k = Eigen::Vector3f(0.3f, 0.f, 2.f);
+  return p;
+}
+
+// A keyframe of the straight's segment, made at frame 200, holding `points`.
+int keyframeHolding(Straight& d, std::initializer_list<PlacePoint> points) {
+  const int slot = d.map.createKeyframe(d.segment, 9, 200, SE3(), SE3());
+  for (const PlacePoint& p : points) d.map.addPoint(slot, p);
+  d.map.finishKeyframe(slot);
+  return slot;
+}
+
 TEST(PlaceMap, AnArbitraryUnitIsRescaledEverywhere) {
   Straight d = straight();
   d.map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0), /*from_frame=*/0, {});
@@ -162,15 +182,10 @@ TEST(PlaceMap, AnArbitraryUnitIsRescaledEverywhere) {
 TEST(PlaceMap, APointScalesAlongTheRayOfTheCameraThatSawIt) {
   Straight d = straight();
   PlaceMap& map = d.map;
-  const int slot = map.createKeyframe(d.segment, 9, 200, SE3(), SE3());
-  PlacePoint side = pointAt(1, 90), unknown = pointAt(2, 91);
-  side.cam = 1;
-  side.p_k = Eigen::Vector3f(0.3f, 0.f, 2.f);
+  PlacePoint unknown = pointAt(2, 91);
   unknown.cam = 5;
-  map.addPoint(slot, side);
-  map.addPoint(slot, unknown);
-  map.finishKeyframe(slot);
-  const std::vector<Vec3> centers{Vec3::Zero(), Vec3(0.3, 0, 0.1)};
+  const int slot = keyframeHolding(d, {sidePoint(1, 90), unknown});
+  const std::vector<Vec3>& centers = kTwoCameraCentres;
   map.rescaleSegment(d.segment, 2.0, Vec3(2, 0, 0), /*from_frame=*/0, centers);
   const auto p = map.points(slot);
   ASSERT_EQ(p.size(), 2u);
@@ -185,16 +200,10 @@ TEST(PlaceMap, APointScalesAlongTheRayOfTheCameraThatSawIt) {
 TEST(PlaceMap, AMeasuredUnitScalesOneCamerasPointsAndIsRemembered) {
   Straight d = straight();
   PlaceMap& map = d.map;
-  const int slot = map.createKeyframe(d.segment, 9, 200, SE3(), SE3());
-  PlacePoint front = pointAt(1, 90), side = pointAt(2, 91);
+  PlacePoint front = pointAt(1, 90);
   front.cam = 0;
-  side.cam = 1;
-  side.p_k = Eigen::Vector3f(0.3f, 0.f, 2.f);
-  map.addPoint(slot, front);
-  map.addPoint(slot, side);
-  map.finishKeyframe(slot);
-  const std::vector<Vec3> centers{Vec3::Zero(), Vec3(0.3, 0, 0.1)};
-  map.takeMeasuredUnit(slot, 1, 0.5, centers);
+  const int slot = keyframeHolding(d, {front, sidePoint(2, 91)});
+  map.takeMeasuredUnit(slot, 1, 0.5, kTwoCameraCentres);
   EXPECT_TRUE(map.points(slot)[0].p_k.isApprox(Eigen::Vector3f(1.f, 0.f, 1.f)));     // camera 0's: as it was
   EXPECT_TRUE(map.points(slot)[1].p_k.isApprox(Eigen::Vector3f(0.3f, 0.f, 1.05f)));  // 0.1 + 0.5 (2 - 0.1)
   EXPECT_EQ(map.keyframe(slot).cameras_unit_measured, uint64_t{2});
