@@ -349,7 +349,7 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstim
   scale_->start(!metric);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
   ++stats_.keyframes;
-  tracker_->startFrom(map_, kf_new, frame_index);  // from the landmarks of the new keyframe
+  tracker_->startFrom(map_, kf_new, frame_index, !metric || cams == 1);  // from the landmarks of the new keyframe
   lost_frames_ = 0;
   for (int k = 0; k < map_.keyframeCapacity(); ++k)
     if (map_.keyframe(k).alive) noteSettled(k);  // the keyframes of the start are final: solved once

@@ -67,6 +67,7 @@ bool Tracker::track(const Map& map, const FrameFeatures& frame, uint64_t frame_i
   } else {
     T_w_b = coarse;
   }
+  most_tracked_since_keyframe_ = std::max(most_tracked_since_keyframe_, inliers);
   // Landmarks found in this frame.
   for (int c = 0; c < frame.cameras(); ++c) {
     for (int k = 0; k < frame.sets[c].count; ++k) {
@@ -204,19 +205,34 @@ const SE3& Tracker::coast() {
 }
 
 bool Tracker::needKeyframe(const Map& map, const SE3& T_w_b, int inliers, uint64_t frame_index) const {
-  if (frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval)) return true;
-  if (inliers < options_.keyframe_tracked_ratio * last_keyframe_tracked_) return true;
+  // Motion since the last keyframe, as shares of the thresholds: rotation, and translation against the typical
+  // depth of what is tracked.
   const SE3 motion = last_keyframe_pose_.inverse() * T_w_b;
-  if (so3Log(motion.R).norm() * 180.0 / M_PI > options_.keyframe_rotation_deg) return true;
-  // Translation against the typical depth of what is tracked.
+  const double turned = so3Log(motion.R).norm() * 180.0 / M_PI / options_.keyframe_rotation_deg;
+  const double travelled = motion.t.norm() / (options_.keyframe_translation_ratio * trackedDepth(map, T_w_b));
+  if (turned > 1 || travelled > 1) return true;
+  // A map whose unit rests on its window (one camera, no overlap) carries that unit from keyframe to keyframe: it
+  // keeps keyframes as dense as all its keyframe's landmarks and the interval make them, standing or not.
+  if (unit_on_window_) {
+    return inliers < options_.keyframe_tracked_ratio * last_keyframe_landmarks_ ||
+           frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval);
+  }
+  // Against the most a frame tracked since the keyframe, not all the keyframe holds: its own new landmarks that
+  // no later frame finds again (a poor match, a highlight, a passer-by) are no loss of the map.
+  if (inliers < options_.keyframe_tracked_ratio * most_tracked_since_keyframe_) return true;
+  // The interval keeps the window's keyframes close in time; a rig that stands still would only copy its keyframe.
+  const bool due = frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval);
+  return due && std::max(turned, travelled) >= options_.keyframe_still_share;
+}
+
+double Tracker::trackedDepth(const Map& map, const SE3& T_w_b) const {
   double depth_sum = 0;
   int depth_n = 0;
   for (int i = 0; i < last_tracked_count_ && depth_n < 200; ++i) {
     depth_sum += (map.landmark(last_tracked_[i]).p_w - T_w_b.t).norm();
     ++depth_n;
   }
-  const double depth = depth_n ? depth_sum / depth_n : 1.0;
-  return motion.t.norm() > options_.keyframe_translation_ratio * depth;
+  return depth_n ? depth_sum / depth_n : 1.0;
 }
 
 int Tracker::countKeyframeLandmarks(const Map& map, int slot) const {
@@ -233,7 +249,7 @@ void Tracker::keyframeSettled(const Map& map, int slot) {
   // Frames tracked since the keyframe were tracked against the map before its solve: they move with the keyframe.
   T_w_last_ = moved_since_keyframe_ ? settled * last_keyframe_pose_.inverse() * T_w_last_ : settled;
   last_keyframe_pose_ = settled;
-  last_keyframe_tracked_ = countKeyframeLandmarks(map, slot);
+  last_keyframe_landmarks_ = countKeyframeLandmarks(map, slot);
   int kept = 0;
   for (int i = 0; i < last_tracked_count_; ++i) {
     if (map.landmark(last_tracked_[i]).alive) last_tracked_[kept++] = last_tracked_[i];
@@ -255,18 +271,20 @@ void Tracker::rememberTracked(const Map& map, const FrameFeatures& frame, uint64
   }
 }
 
-void Tracker::startFrom(const Map& map, int slot, uint64_t frame_index) {
+void Tracker::startFrom(const Map& map, int slot, uint64_t frame_index, bool unit_on_window) {
+  unit_on_window_ = unit_on_window;
   T_w_last_ = map.keyframe(slot).T_w_b;
   moved_since_keyframe_ = false;
   have_velocity_ = false;
   last_keyframe_frame_ = frame_index;
   last_keyframe_pose_ = T_w_last_;
-  last_keyframe_tracked_ = countKeyframeLandmarks(map, slot);
+  most_tracked_since_keyframe_ = 0;
   last_tracked_count_ = 0;
   // The frame the map starts on saw every landmark of its keyframe: the next one, tracked with no motion model
   // yet, must find a fair share of them before its first attempt is trusted (after a relocalization in a turn,
   // the stale prediction finds a chance consensus of repeated texture).
-  last_coarse_inliers_ = last_keyframe_tracked_;
+  last_keyframe_landmarks_ = countKeyframeLandmarks(map, slot);
+  last_coarse_inliers_ = last_keyframe_landmarks_;
   const Keyframe& kf = map.keyframe(slot);
   for (int c = 0; c < kf.features.cameras(); ++c) {
     for (int k = 0; k < kf.features.sets[c].count; ++k) {

@@ -78,6 +78,7 @@ void readKeyframes(ConfigSection s, PipelineConfig& c) {
   OdometryOptions& o = c.odometry;
   s.read("tracked_ratio", o.keyframe_tracked_ratio, 0.0, 1.0);
   s.read("max_interval", o.keyframe_max_interval, 1, 10000);
+  s.read("still_share", o.keyframe_still_share, 0.0, 1.0);
   s.read("rotation_deg", o.keyframe_rotation_deg, 0.1, 180.0);
   s.read("translation_ratio", o.keyframe_translation_ratio, 0.001, 10.0);
   s.finish();
@@ -224,6 +225,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "  keyframes:\n"
      << "    tracked_ratio: " << o.keyframe_tracked_ratio << "\n"
      << "    max_interval: " << o.keyframe_max_interval << "\n"
+     << "    still_share: " << o.keyframe_still_share << "\n"
      << "    rotation_deg: " << o.keyframe_rotation_deg << "\n"
      << "    translation_ratio: " << o.keyframe_translation_ratio << "\n"
      << "  initialization:\n"

@@ -235,6 +235,35 @@ TEST(OdometrySynthetic, Stereo) {
   }
 }
 
+// A rig standing still sees what its keyframe saw from where it stood: a keyframe of it would add nothing to the
+// map, however long it stands (the place map would fill with copies of one pose).
+TEST(OdometrySynthetic, AStandingRigMakesNoKeyframes) {
+  test::SyntheticSequenceOptions so;
+  so.speed_mps = 0;
+  so.frames = 80;
+  const RunResult r = runSequence(test::isecRig().subset({1, 2}), so, false);
+  EXPECT_EQ(r.stats.tracking, 80u);
+  ASSERT_FALSE(r.keyframe_frames.empty());
+  EXPECT_EQ(r.keyframe_frames.back(), r.first_tracked) << "only the map's first keyframe, of the first frame";
+}
+
+// Landmarks made at a keyframe that the frames after it never find (the point was a highlight, a passer-by, the
+// detector's flicker) are no share of the map that tracking has lost: a keyframe comes when the frames track
+// less than they did after the last one, not less than the keyframe held.
+TEST(OdometrySynthetic, LandmarksNoLaterFrameFindsMakeNoKeyframes) {
+  test::SyntheticSequenceOptions so;
+  so.frames = 100;
+  so.speed_mps = 0.5;
+  const Rig stereo = test::isecRig().subset({1, 2});
+  const RunResult steady = runSequence(stereo, so, false);
+  so.one_frame_points = so.points / 2;  // a third of each frame's features
+  const RunResult transient = runSequence(stereo, so, false);
+  EXPECT_EQ(transient.stats.lost, 0u);
+  EXPECT_LT(transient.ate, 0.08);
+  EXPECT_LE(transient.stats.keyframes, steady.stats.keyframes * 3 / 2)
+      << "without one-frame points " << steady.stats.keyframes << " keyframes in " << so.frames << " frames";
+}
+
 // A rig without overlap starts up to scale (two frames cannot fix it with 10 cm lever arms) and keeps that unit
 // until the window estimates, combined, move it (a confident correction) and say when it is metric. Before that
 // frame the trajectory's unit is arbitrary; from it on it must be metric.

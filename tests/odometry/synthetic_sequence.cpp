@@ -79,38 +79,37 @@ SE3 bodyPose(double s, const SyntheticSequenceOptions& o) {
 }
 }  // namespace
 
-SyntheticSequence::SyntheticSequence(const Rig& rig, const SyntheticSequenceOptions& o)
-    : rig_(rig), options_(o), rng_(o.seed) {
+// Points on a cylinder wall around the loop, on the floor and on a few pillars inside.
+SyntheticSequence::Point SyntheticSequence::drawPoint(std::mt19937& rng) const {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::uniform_int_distribution<uint64_t> bits;
-  // Points on a cylinder wall around the loop, on the floor and on a few pillars inside.
+  const SyntheticSequenceOptions& o = options_;
   const double wall = o.radius_m * 1.25 + 3.0;
-  for (int i = 0; i < o.points; ++i) {
-    Vec3 p;
-    const double kind = u(rng_);
-    if (kind < 0.6) {
-      const double a = 2 * M_PI * u(rng_);
-      const double rr = wall + 2.0 * u(rng_);
-      p = Vec3(rr * std::cos(a), rr * std::sin(a), 3.0 * u(rng_));
-    } else if (kind < 0.8) {
-      const double a = 2 * M_PI * u(rng_);
-      const double rr = o.radius_m * 0.5 * u(rng_);
-      p = Vec3(rr * std::cos(a), rr * std::sin(a), 2.5 * u(rng_));
-    } else {
-      const double a = 2 * M_PI * u(rng_);
-      const double rr = wall * std::sqrt(u(rng_));
-      p = Vec3(rr * std::cos(a), rr * std::sin(a), 0.0);
-    }
-    points_.push_back(p);
-    Descriptor d;
-    for (auto& w : d) w = bits(rng_);
-    descriptors_.push_back(d);
-    // Octaves as an ORB pyramid spreads them (each level holds 1/1.2 of the one below); a point keeps its
-    // octave in every view, as its image scale changes little along the sequence.
-    int octave = 0;
-    while (octave < 7 && u(rng_) < 1.0 / 1.2) ++octave;
-    octaves_.push_back(octave);
+  Point point;
+  const double kind = u(rng);
+  if (kind < 0.6) {
+    const double a = 2 * M_PI * u(rng);
+    const double rr = wall + 2.0 * u(rng);
+    point.p_w = Vec3(rr * std::cos(a), rr * std::sin(a), 3.0 * u(rng));
+  } else if (kind < 0.8) {
+    const double a = 2 * M_PI * u(rng);
+    const double rr = o.radius_m * 0.5 * u(rng);
+    point.p_w = Vec3(rr * std::cos(a), rr * std::sin(a), 2.5 * u(rng));
+  } else {
+    const double a = 2 * M_PI * u(rng);
+    const double rr = wall * std::sqrt(u(rng));
+    point.p_w = Vec3(rr * std::cos(a), rr * std::sin(a), 0.0);
   }
+  for (auto& w : point.descriptor) w = bits(rng);
+  // Octaves as an ORB pyramid spreads them (each level holds 1/1.2 of the one below); a point keeps its
+  // octave in every view, as its image scale changes little along the sequence.
+  while (point.octave < 7 && u(rng) < 1.0 / 1.2) ++point.octave;
+  return point;
+}
+
+SyntheticSequence::SyntheticSequence(const Rig& rig, const SyntheticSequenceOptions& o)
+    : rig_(rig), options_(o), rng_(o.seed) {
+  for (int i = 0; i < o.points; ++i) points_.push_back(drawPoint(rng_));
   const double length_per_frame = o.speed_mps / o.rate_hz;
   for (int i = 0; i < o.frames; ++i) {
     StampedPose sp;
@@ -126,21 +125,26 @@ void SyntheticSequence::fill(int i, FrameFeatures& out) {
   out.clear();
   out.t = truth_[i].t;
   const SE3& T_w_b = truth_[i].T_w_b;
+  frame_points_.clear();
+  std::mt19937 frame_rng(static_cast<uint32_t>(options_.seed * 7919 + static_cast<uint64_t>(i)));  // not rng_'s draws
+  for (int k = 0; k < options_.one_frame_points; ++k) frame_points_.push_back(drawPoint(frame_rng));
   for (int c = 0; c < rig_.size(); ++c) {
     out.present[c] = 1;
     const SE3 T_c_w = (T_w_b * rig_.T_b_c(c)).inverse();
     const CameraModel& m = rig_.model(c);
     struct Item {
       double depth;
-      int point;
+      const Point* point;
       Vec2 uv;
     };
     std::vector<Item> items;
-    for (int p = 0; p < static_cast<int>(points_.size()); ++p) {
-      const Vec3 pc = T_c_w * points_[p];
-      Vec2 uv;
-      if (pc.z() < 0.2 || !m.project(pc, uv) || !m.inImage(uv, 20)) continue;
-      items.push_back({pc.z(), p, uv});
+    for (const std::vector<Point>* set : {&points_, &frame_points_}) {
+      for (const Point& point : *set) {
+        const Vec3 pc = T_c_w * point.p_w;
+        Vec2 uv;
+        if (pc.z() < 0.2 || !m.project(pc, uv) || !m.inImage(uv, 20)) continue;
+        items.push_back({pc.z(), &point, uv});
+      }
     }
     // The detector keeps the best-spread features up to its budget: here the nearest ones.
     std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.depth < b.depth; });
@@ -149,12 +153,12 @@ void SyntheticSequence::fill(int i, FrameFeatures& out) {
     for (const Item& it : items) {
       if (set.count == set.capacity()) break;
       Keypoint kp;
-      const int octave = octaves_[it.point];
+      const int octave = it.point->octave;
       const double sigma = std::pow(1.2, octave);
       kp.x = static_cast<float>(it.uv.x() + noise(rng_) * sigma);
       kp.y = static_cast<float>(it.uv.y() + noise(rng_) * sigma);
       kp.octave = static_cast<int8_t>(octave);
-      Descriptor d = descriptors_[it.point];
+      Descriptor d = it.point->descriptor;
       for (int f = 0; f < 10; ++f) {
         const int b = bit(rng_);
         d[b / 64] ^= uint64_t{1} << (b % 64);

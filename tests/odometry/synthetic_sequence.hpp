@@ -28,6 +28,9 @@ struct SyntheticSequenceOptions {
   double speed_mps = 1.0;
   double noise_px = 0.5;
   int points = 15000;
+  // Points that exist in one frame only, this many drawn anew for each frame like the world's (highlights,
+  // passers-by, the detector's flicker): a keyframe makes landmarks of them that no later frame finds.
+  int one_frame_points = 0;
   int max_features = 1000;
   uint64_t seed = 1;
   int warmup_frames = 60;  // frames before allocations are counted (the map and pools reach steady use)
@@ -45,11 +48,17 @@ class SyntheticSequence {
   void fill(int i, FrameFeatures& out);
 
  private:
+  struct Point {
+    Vec3 p_w;
+    Descriptor descriptor;
+    int octave = 0;
+  };
+  Point drawPoint(std::mt19937& rng) const;
+
   Rig rig_;
   SyntheticSequenceOptions options_;
-  std::vector<Vec3> points_;
-  std::vector<Descriptor> descriptors_;
-  std::vector<int> octaves_;
+  std::vector<Point> points_;
+  std::vector<Point> frame_points_;  // the one-frame points of the frame being filled
   Trajectory truth_;
   std::mt19937 rng_;
 };

@@ -34,11 +34,15 @@ struct OdometryOptions {
   double lost_timeout_s = 0;
 
   // Keyframes.
-  double keyframe_tracked_ratio =
-      0.75;                       // new keyframe when tracked landmarks fall below this share of the last keyframe's
-  int keyframe_max_interval = 8;  // frames: at least one keyframe per this many
+  // New keyframe when a frame's tracking inliers fall below this share of the most a frame had since the last
+  // one (of all the last keyframe's landmarks in a map whose unit rests on its window: one camera, no overlap).
+  double keyframe_tracked_ratio = 0.75;
+  int keyframe_max_interval = 8;  // frames: at least one keyframe per this many, while the rig moves (below)
   double keyframe_rotation_deg = 8.0;
   double keyframe_translation_ratio = 0.08;  // translation / median scene depth since the last keyframe
+  // A rig that has turned and travelled less than this share of both thresholds above since its last keyframe
+  // stands still: the interval makes no keyframe of it (in a map that started metric).
+  double keyframe_still_share = 0.25;
 
   // Initialization.
   int init_min_multiview = 40;      // metric multi-view features needed to initialize from one frame

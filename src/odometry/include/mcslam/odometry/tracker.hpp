@@ -38,6 +38,7 @@ class Tracker {
     last_keyframe_frame_ = frame_index;
     last_keyframe_pose_ = T_w_b;
     moved_since_keyframe_ = false;
+    most_tracked_since_keyframe_ = 0;
   }
   // Keyframe `slot` is final (optimized, culled): the next frames continue from its pose, with the same velocity
   // (frames tracked since it move with the keyframe's correction), and landmarks the back-end or the culling erased
@@ -46,8 +47,9 @@ class Tracker {
   // The landmarks matched in this frame become the first attempt's list for the next one.
   void rememberTracked(const Map& map, const FrameFeatures& frame, uint64_t frame_index);
   // A new map starts at its keyframe `slot` (of frame `frame_index`): tracking continues from its pose and
-  // landmarks, without velocity.
-  void startFrom(const Map& map, int slot, uint64_t frame_index);
+  // landmarks, without velocity. `unit_on_window`: the map's unit rests on the back-end window (one camera, or a
+  // start up to scale), which sets the keyframe rule (needKeyframe).
+  void startFrom(const Map& map, int slot, uint64_t frame_index, bool unit_on_window);
   // The map was dropped: nothing tracked, no velocity (the pose stays).
   void reset();
   // The map took a new unit: positions about `center` times s.
@@ -73,6 +75,8 @@ class Tracker {
   int poseFromMatches(const Map& map, const FrameFeatures& frame, const SE3& guess, bool use_ransac, SE3& T_w_b);
   int searchNewestKeyframeByDescriptor(const Map& map, const FrameFeatures& frame);
   int countKeyframeLandmarks(const Map& map, int slot) const;
+  // Mean distance of the landmarks tracked in the last frame (up to 200) from T_w_b.
+  double trackedDepth(const Map& map, const SE3& T_w_b) const;
 
   RigState rig_;  // a copy of the odometry's, taken at frame boundaries
   OdometryOptions options_;
@@ -93,8 +97,10 @@ class Tracker {
   SE3 velocity_;  // relative motion of the last frame step
   uint64_t last_keyframe_frame_ = 0;
   SE3 last_keyframe_pose_;
-  bool moved_since_keyframe_ = false;  // T_w_last_ is a frame after the last keyframe, not the keyframe itself
-  int last_keyframe_tracked_ = 0;
+  bool moved_since_keyframe_ = false;    // T_w_last_ is a frame after the last keyframe, not the keyframe itself
+  int last_keyframe_landmarks_ = 0;      // keypoints of the last keyframe with a landmark
+  int most_tracked_since_keyframe_ = 0;  // inliers of the best frame tracked since the last keyframe
+  bool unit_on_window_ = false;          // the map started up to scale or with one camera
   int expected_matches_ = 0;  // of the last frame: what the local map predicted in the images (the quality's base)
   double rotation_travelled_ = 0;
   uint64_t recoveries_ = 0;
