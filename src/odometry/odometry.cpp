@@ -335,6 +335,7 @@ int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame
 
 void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out, bool new_map) {
   const int cams = bridge_->rigState().cameras();
+  const bool unit_on_window = !metric || cams == 1;
   initializer_->reset();
   initialized_ = true;
   bridge_->setScaleStatus(cams == 1 ? ScaleStatus::Monocular : metric ? ScaleStatus::Metric : ScaleStatus::Unscaled);
@@ -342,14 +343,14 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstim
   // the scale supervisor's rescales change it: a free window lets the scale random-walk wherever no turn
   // constrains it. resetMap() lets it go.
   if (!metric && cams > 1) bridge_->holdScale(true);
-  triangulator_->setSceneReferencedPoints(!metric || cams == 1);
+  triangulator_->setSceneReferencedPoints(unit_on_window);
   // A map whose unit rests on its window (one camera, or no overlap before the scale is found) tracks on solved
   // maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
   apply_after_frames_ = metric && cams > 1 ? options_.backend_apply_after_frames : 1;
   scale_->start(!metric);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
   ++stats_.keyframes;
-  tracker_->startFrom(map_, kf_new, frame_index, !metric || cams == 1);  // from the landmarks of the new keyframe
+  tracker_->startFrom(map_, kf_new, frame_index, unit_on_window);  // from the landmarks of the new keyframe
   lost_frames_ = 0;
   for (int k = 0; k < map_.keyframeCapacity(); ++k)
     if (map_.keyframe(k).alive) noteSettled(k);  // the keyframes of the start are final: solved once

@@ -211,18 +211,16 @@ bool Tracker::needKeyframe(const Map& map, const SE3& T_w_b, int inliers, uint64
   const double turned = so3Log(motion.R).norm() * 180.0 / M_PI / options_.keyframe_rotation_deg;
   const double travelled = motion.t.norm() / (options_.keyframe_translation_ratio * trackedDepth(map, T_w_b));
   if (turned > 1 || travelled > 1) return true;
-  // A map whose unit rests on its window (one camera, no overlap) carries that unit from keyframe to keyframe: it
-  // keeps keyframes as dense as all its keyframe's landmarks and the interval make them, standing or not.
-  if (unit_on_window_) {
-    return inliers < options_.keyframe_tracked_ratio * last_keyframe_landmarks_ ||
-           frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval);
-  }
+  const bool interval_due = frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval);
+  // A map whose unit rests on its window (one camera, or a start up to scale) carries that unit from keyframe to
+  // keyframe: it keeps keyframes as dense as all its keyframe's landmarks and the interval make them, standing
+  // or not.
+  if (unit_on_window_) return inliers < options_.keyframe_tracked_ratio * last_keyframe_landmarks_ || interval_due;
   // Against the most a frame tracked since the keyframe, not all the keyframe holds: its own new landmarks that
   // no later frame finds again (a poor match, a highlight, a passer-by) are no loss of the map.
   if (inliers < options_.keyframe_tracked_ratio * most_tracked_since_keyframe_) return true;
   // The interval keeps the window's keyframes close in time; a rig that stands still would only copy its keyframe.
-  const bool due = frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval);
-  return due && std::max(turned, travelled) >= options_.keyframe_still_share;
+  return interval_due && std::max(turned, travelled) >= options_.keyframe_still_share;
 }
 
 double Tracker::trackedDepth(const Map& map, const SE3& T_w_b) const {

@@ -126,7 +126,8 @@ void SyntheticSequence::fill(int i, FrameFeatures& out) {
   out.t = truth_[i].t;
   const SE3& T_w_b = truth_[i].T_w_b;
   frame_points_.clear();
-  std::mt19937 frame_rng(static_cast<uint32_t>(options_.seed * 7919 + static_cast<uint64_t>(i)));  // not rng_'s draws
+  // Their own generator: the world's points and rng_'s draws stay as they are without them.
+  std::mt19937 frame_rng(static_cast<uint32_t>(options_.seed * 7919 + static_cast<uint64_t>(i)));
   for (int k = 0; k < options_.one_frame_points; ++k) frame_points_.push_back(drawPoint(frame_rng));
   for (int c = 0; c < rig_.size(); ++c) {
     out.present[c] = 1;

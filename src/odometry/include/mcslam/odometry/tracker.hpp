@@ -26,7 +26,8 @@ class Tracker {
   void follow(const RigState& state);
 
   // Pose of `frame` against `map` (its live list refreshed). False when lost; `inliers` then says how many the
-  // best attempt had. On success the matches (matches()) are the inliers of the pose.
+  // best attempt had. On success the matches (matches()) are the inliers of the pose, and the inliers count
+  // towards the keyframe rule's reference (the most since the last keyframe).
   bool track(const Map& map, const FrameFeatures& frame, uint64_t frame_index, SE3& T_w_b, int& inliers);
   // The frame was tracked at T_w_b: the motion model moves on.
   void advance(const SE3& T_w_b);
