@@ -346,7 +346,7 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstim
   triangulator_->setSceneReferencedPoints(unit_on_window);
   // A map whose unit rests on its window (one camera, or no overlap before the scale is found) tracks on solved
   // maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
-  apply_after_frames_ = metric && cams > 1 ? options_.backend_apply_after_frames : 1;
+  apply_after_frames_ = unit_on_window ? 1 : options_.backend_apply_after_frames;
   scale_->start(!metric);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
   ++stats_.keyframes;

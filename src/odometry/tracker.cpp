@@ -209,8 +209,9 @@ bool Tracker::needKeyframe(const Map& map, const SE3& T_w_b, int inliers, uint64
   // depth of what is tracked.
   const SE3 motion = last_keyframe_pose_.inverse() * T_w_b;
   const double turned = so3Log(motion.R).norm() * 180.0 / M_PI / options_.keyframe_rotation_deg;
+  if (turned > 1) return true;
   const double travelled = motion.t.norm() / (options_.keyframe_translation_ratio * trackedDepth(map, T_w_b));
-  if (turned > 1 || travelled > 1) return true;
+  if (travelled > 1) return true;
   const bool interval_due = frame_index - last_keyframe_frame_ >= static_cast<uint64_t>(options_.keyframe_max_interval);
   // A map whose unit rests on its window (one camera, or a start up to scale) carries that unit from keyframe to
   // keyframe: it keeps keyframes as dense as all its keyframe's landmarks and the interval make them, standing
