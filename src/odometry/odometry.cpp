@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "extrinsic_check.hpp"
+#include "mcslam/odometry/initialization_attempt.hpp"
 #include "mcslam/odometry/initializer.hpp"
 #include "mcslam/odometry/local_mapper.hpp"
 #include "mcslam/odometry/scale_supervisor.hpp"
@@ -30,6 +31,8 @@ Odometry::Odometry(const Rig& rig, const OdometryOptions& options, int max_featu
   const int cams = rig.size();
   tracker_ = std::make_unique<Tracker>(rig, options_, max_features_per_camera);
   initializer_ = std::make_unique<Initializer>(rig, options_, max_features_per_camera);
+  attempt_ =
+      std::make_unique<InitializationAttempt>(*initializer_, cams, max_features_per_camera, options.backend_thread);
   mapper_ = std::make_unique<LocalMapper>(options_);
   bridge_ = std::make_unique<WindowBridge>(rig, options_, max_features_per_camera);
   triangulator_ = std::make_unique<TemporalTriangulator>(rig, options_, max_features_per_camera);
@@ -53,13 +56,14 @@ double Odometry::unitSigma() const {
 }
 
 uint64_t Odometry::backendThreadAllocations() const {
-  return bridge_->backendThreadAllocations() + scale_->threadAllocations();
+  return bridge_->backendThreadAllocations() + scale_->threadAllocations() + attempt_->threadAllocations();
 }
 
 void Odometry::resetMap() {
   pending_keyframe_ = -1;  // its window goes with the map
   mapping_due_ = false;
   clearMap();
+  attempt_->cancel();  // an attempt in flight uses the initializer
   initializer_->reset();
   if (extrinsic_check_) extrinsic_check_->reset();
   tracker_->reset();
@@ -89,13 +93,16 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   rescale_count_ = 0;
   applyDueSolve();
   tracker_->follow(bridge_->rigState());  // a frame boundary: tracking takes the rig state as it is now
-  const auto start = Clock::now();
+  auto start = Clock::now();
   const double flushed_ms = timing_.mapping_ms + timing_.backend_ms;
 
   if (!initialized_) {
-    initialize(frame, frame_index, out);
+    const bool started_before = initialize(frame, frame_index, out);
     timing_.tracking_ms = msSince(start) - (timing_.mapping_ms + timing_.backend_ms - flushed_ms);
-    return;
+    if (!started_before) return;
+    // The map started at the last frame (its attempt's result): this frame is tracked on it.
+    tracker_->follow(bridge_->rigState());
+    start = Clock::now();
   }
 
   if (lost_frames_ > options_.max_lost_frames) {
@@ -103,7 +110,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
     // memory's relocalization (verified against the place map) brings the frame back, until the timeout starts a
     // new map.
     lose(frame_index, 0, out);
-    timing_.tracking_ms = msSince(start);
+    timing_.tracking_ms += msSince(start);
     return;
   }
   SE3 T_w_b;
@@ -111,7 +118,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
   map_.refreshLiveList();  // tracking and the extrinsic check read the live list
   if (!tracker_->track(map_, frame, frame_index, T_w_b, inliers)) {
     lose(frame_index, inliers, out);
-    timing_.tracking_ms = msSince(start);
+    timing_.tracking_ms += msSince(start);
     return;
   }
   lost_frames_ = 0;
@@ -128,7 +135,7 @@ void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, Po
     }
   }
   tracker_->advance(T_w_b);
-  timing_.tracking_ms = msSince(start);
+  timing_.tracking_ms += msSince(start);
 
   if (tracker_->needKeyframe(map_, T_w_b, inliers, frame_index)) {
     if (pending_keyframe_ >= 0) {
@@ -181,7 +188,7 @@ void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, co
     deferMapping(slot);
     spdlog::trace("odometry: frame {}: keyframe, {} inliers, new landmarks on the back-end thread", frame_index,
                   inliers);
-    timing_.mapping_ms = msSince(map_start);
+    timing_.mapping_ms += msSince(map_start);
   } else {
     mapNow(slot, frame_index, inliers, map_start);
   }
@@ -198,13 +205,13 @@ void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, co
 void Odometry::mapNow(int slot, uint64_t frame_index, int inliers, Clock::time_point map_start) {
   const int created = triangulateNew(slot);
   spdlog::trace("odometry: frame {}: keyframe, {} inliers, {} new landmarks", frame_index, inliers, created);
-  timing_.mapping_ms = msSince(map_start);
+  timing_.mapping_ms += msSince(map_start);
   const auto be_start = Clock::now();
   if (bridge_->beginSolve(map_, slot)) {
     pending_keyframe_ = slot;
     pending_frames_ = 0;
   }
-  timing_.backend_ms = msSince(be_start);
+  timing_.backend_ms += msSince(be_start);
 }
 
 // Where the next frame waits for this keyframe's solve anyway, and a thread can take the mapping.
@@ -281,19 +288,37 @@ void Odometry::estimateScale() {
   scale_->startEstimate(map_, bridge_->rigState(), tracker_->rotationTravelled(), frame_index_);
 }
 
-void Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
+bool Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
   out.T_w_b = anchor_;
   out.state = TrackingState::NotInitialized;
-  last_init_reference_ = -1;
-  initializer_->follow(bridge_->rigState());  // a frame boundary
-  bool metric = true;
-  const int kf_new = initializer_->oneFrameReady(frame) ? initializeFromOneFrame(frame, frame_index)
-                                                        : initializeFromTwoFrames(frame, frame_index, metric);
-  if (kf_new < 0) {
-    ++stats_.not_initialized;
-    return;
+  last_init_ = InitializationSpan{};
+  if (attempt_->pending() && startFromAttempt()) return true;
+  initializer_->follow(bridge_->rigState());  // a frame boundary, and no attempt in flight
+  if (initializer_->oneFrameReady(frame)) {
+    const int kf_new = initializeFromOneFrame(frame, frame_index);
+    if (kf_new >= 0) {
+      startMap(kf_new, frame_index, /*metric=*/true);
+      publishStart(out);
+      return false;
+    }
+  } else {
+    attempt_->submit(frame, frame_index);  // taken at the next frame
   }
-  startMap(kf_new, frame_index, metric, out);
+  ++stats_.not_initialized;
+  return false;
+}
+
+bool Odometry::startFromAttempt() {
+  SE3 T_ref_cur;
+  if (attempt_->collect(T_ref_cur) != Initializer::TwoFrame::Ready) return false;
+  bool metric = true;
+  const uint64_t start_index = attempt_->frameIndex();
+  const int kf_new = initializeFromTwoFrames(attempt_->frame(), start_index, T_ref_cur, metric);
+  if (kf_new < 0) return false;
+  startMap(kf_new, start_index, metric);
+  last_init_.start = static_cast<int64_t>(start_index);
+  last_init_.T_w_start = tracker_->pose();
+  return true;
 }
 
 int Odometry::initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_index) {
@@ -305,9 +330,8 @@ int Odometry::initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_
   return kf_new;
 }
 
-int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, bool& metric) {
-  SE3 T_ref_cur;
-  if (initializer_->feed(frame, frame_index, T_ref_cur) != Initializer::TwoFrame::Ready) return -1;
+int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_ref_cur,
+                                      bool& metric) {
   const auto map_start = Clock::now();
   const FrameFeatures& ref = initializer_->reference();
   const uint64_t ref_index = initializer_->referenceIndex();
@@ -327,13 +351,14 @@ int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame
   bridge_->optimize(map_, kf_ref);
   bridge_->optimize(map_, kf_new);
   timing_.backend_ms = msSince(be_start);
-  last_init_reference_ = static_cast<int64_t>(ref_index);
+  last_init_.reference = static_cast<int64_t>(ref_index);
+  last_init_.T_w_reference = map_.keyframe(kf_ref).T_w_b;
   // One camera: never metric, nothing to wait for.
   metric = initializer_->lastMetric() || bridge_->rigState().cameras() == 1;
   return kf_new;
 }
 
-void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out, bool new_map) {
+void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, bool new_map) {
   const int cams = bridge_->rigState().cameras();
   const bool unit_on_window = !metric || cams == 1;
   initializer_->reset();
@@ -354,6 +379,9 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstim
   lost_frames_ = 0;
   for (int k = 0; k < map_.keyframeCapacity(); ++k)
     if (map_.keyframe(k).alive) noteSettled(k);  // the keyframes of the start are final: solved once
+}
+
+void Odometry::publishStart(PoseEstimate& out) {
   ++stats_.tracking;
   out.T_w_b = tracker_->pose();
   out.state = TrackingState::Tracking;
@@ -380,7 +408,8 @@ void Odometry::relocalize(const FrameFeatures& frame, uint64_t frame_index, cons
   out = PoseEstimate{};
   out.t = frame.t;
   out.sequence = frame_index;
-  startMap(kf, frame_index, status != ScaleStatus::Unscaled, out, /*new_map=*/false);
+  startMap(kf, frame_index, status != ScaleStatus::Unscaled, /*new_map=*/false);
+  publishStart(out);
 }
 
 }  // namespace mcslam

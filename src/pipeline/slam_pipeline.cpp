@@ -68,6 +68,7 @@ void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Times
     places_->afterOdometry(features, sequence, odometry_, out);
     timing.places_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
+  noteInitialization();
   odometry_.startDeferredMapping();  // place memory is done with the frame's landmarks
   if (handover_) {
     rig_after_[frames_tracked_ % 2].follow(odometry_.rigState());  // by value, allocates nothing
@@ -77,6 +78,16 @@ void SlamPipeline::track(const FrameFeatures& features, uint64_t sequence, Times
   const OdometryTiming& o = odometry_.timing();
   timing.tracking_ms = o.tracking_ms + o.mapping_ms;
   timing.optimization_ms = o.backend_ms;
+}
+
+// The start's poses in the world frame, as place memory moved the frame's (the same segment).
+void SlamPipeline::noteInitialization() {
+  initialization_ = odometry_.lastInitialization();
+  if (initialization_.start < 0 || !places_) return;
+  if (!places_->toWorld(initialization_.T_w_reference, initialization_.T_w_reference) ||
+      !places_->toWorld(initialization_.T_w_start, initialization_.T_w_start)) {
+    initialization_ = Odometry::InitializationSpan{};
+  }
 }
 
 void SlamPipeline::prepare(const RigFrameView& frame, int slot) {

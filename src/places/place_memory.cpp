@@ -78,6 +78,16 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   out.unanchored = out.valid && segment_ >= 0 && !anchored_[static_cast<std::size_t>(segment_)];
 }
 
+bool PlaceMemory::toWorld(const SE3& T_o_b, SE3& T_w_b) const {
+  if (segment_ < 0) {
+    T_w_b = T_o_b;
+    return true;
+  }
+  if (!map_.placed(segment_)) return false;
+  T_w_b = map_.toWorld(segment_, T_o_b);
+  return true;
+}
+
 // A new odometry map (after a loss nothing bridged, or the very first) is a new segment. Its frame continues the
 // old one's (the odometry starts it at the pose it coasted to), so it starts with the same T_w_o; a later
 // recognition joins it to the map.

@@ -25,8 +25,10 @@ struct RunResult {
   double ate = 0;
   double scale = 1;
   uint64_t allocations_after_warmup = 0;
-  int first_tracked = -1;                                   // first tracked frame
-  int first_metric = -1;                                    // first tracked frame whose pose says it is metric
+  int first_tracked = -1;    // first tracked frame
+  int64_t start_frame = -1;  // the frame a map from two frames started at (Odometry::lastInitialization())
+  int start_seen = -1;       // the frame that started it
+  int first_metric = -1;     // first tracked frame whose pose says it is metric
   int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
   std::vector<float> quality;                               // per frame (0 when not tracked)
   std::vector<int> keyframe_frames;                         // frames that made a keyframe (is_keyframe)
@@ -75,6 +77,10 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
         std::printf("frame %d allocs %llu\n", i, (unsigned long long)scope.count());
     }
     if (pose.is_keyframe) r.keyframe_frames.push_back(i);
+    if (odo.lastInitialization().start >= 0 && r.start_frame < 0) {
+      r.start_frame = odo.lastInitialization().start;
+      r.start_seen = i;
+    }
     for (std::size_t k = 0; k < odo.settledKeyframes().size(); ++k) r.settled_frames.push_back(i);
     if (pose.valid && pose.state == TrackingState::Tracking) {
       r.quality[static_cast<std::size_t>(i)] = pose.quality;
@@ -126,17 +132,15 @@ static void expectSolvesAppliedAt(const Rig& rig, int apply_after_frames, int ap
   const RunResult r = runSequence(rig, so, rig.size() == 1, {}, oo);
   EXPECT_EQ(r.stats.lost, 0u);
   EXPECT_LT(r.ate, max_ate);
-  // The first keyframes (the map's start) are settled in the frame that makes them; each later one in the frame
-  // its solve is applied in.
+  // The first keyframes (the map's start) are settled in the frame that starts the map (a start from one frame:
+  // its keyframe; from two: the frame after the second, which takes its attempt); each later one in the frame its
+  // solve is applied in.
   ASSERT_GE(r.keyframe_frames.size(), 10u);
-  const int start = r.keyframe_frames[0];
-  std::vector<int> expected;
+  const int start = r.settled_frames[0];
+  std::vector<int> expected{start};
   for (std::size_t k = 0; k < r.keyframe_frames.size(); ++k) {
     const int kf = r.keyframe_frames[k];
-    if (kf == start) {
-      expected.push_back(kf);
-      continue;
-    }
+    if (kf == start && r.start_frame < 0) continue;  // a start from one frame: its own keyframe
     const int next = k + 1 < r.keyframe_frames.size() ? r.keyframe_frames[k + 1] : so.frames;
     // Due before frame kf + n; a keyframe made earlier applies it first, in its own frame (the last one at the end
     // of the run is applied by flush(), after every frame: not counted).
@@ -183,7 +187,7 @@ TEST(OdometrySynthetic, OneCamerasKeyframeMakesItsNewPointsOnTheBackEndThreadWit
   for (int i = 0; i < so.frames; ++i) {
     const std::size_t f = static_cast<std::size_t>(i);
     const bool keyframe = std::count(now.keyframe_frames.begin(), now.keyframe_frames.end(), i) > 0;
-    if (!keyframe || i == now.keyframe_frames[0]) {  // the map's start triangulates in its frame either way
+    if (!keyframe || i == now.settled_frames[0]) {  // the map's start triangulates in its frame either way
       EXPECT_EQ(deferred.landmarks_at_return[f], now.landmarks_at_return[f]) << "frame " << i;
       continue;
     }
@@ -195,6 +199,22 @@ TEST(OdometrySynthetic, OneCamerasKeyframeMakesItsNewPointsOnTheBackEndThreadWit
   if (test::countsAllocations()) {
     EXPECT_EQ(deferred.allocations_after_warmup, 0u);  // the back-end thread's too
   }
+}
+
+// A start from two frames (one camera here) matches and solves frame k against its reference beside the next frame,
+// whose process() takes the result: the map starts at frame k, which is published as not initialized, and frame
+// k + 1 is the first tracked (InitializationAttempt's own test: the same result as on the caller's thread).
+TEST(OdometrySynthetic, ATwoFrameStartsAttemptIsTakenAtTheNextFrame) {
+  test::SyntheticSequenceOptions so;
+  so.frames = 60;
+  const RunResult r = runSequence(test::isecRig().subset({2}), so, true);
+
+  ASSERT_GE(r.start_frame, 1);
+  EXPECT_EQ(r.start_seen, r.start_frame + 1);
+  EXPECT_EQ(r.first_tracked, r.start_seen);
+  EXPECT_EQ(r.stats.not_initialized, static_cast<uint64_t>(r.start_frame + 1));  // frames 0..k
+  EXPECT_EQ(r.stats.initializations, 1u);
+  EXPECT_LT(r.ate, 0.5);
 }
 
 double meanQuality(const RunResult& r, int first, int last) {

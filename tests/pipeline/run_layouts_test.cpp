@@ -3,6 +3,8 @@
 // agree with each other and with the ground truth each layout carries.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -117,10 +119,13 @@ TEST_F(RunLayouts, TheRunnerSaysWhenTheTrajectoryIsNotMetric) {
   ASSERT_EQ(test::runCommand(common + " --cameras 0", &one), 0) << one;
   EXPECT_NE(one.find("tracking up to scale (one camera)"), std::string::npos) << one;
   EXPECT_NE(one.find("one camera: the trajectory's unit is arbitrary"), std::string::npos) << one;
-  // Every frame with a pose is counted up to scale: those tracked and those interpolated before initialization.
+  // Every frame with a pose is counted up to scale: those tracked, those interpolated before initialization and
+  // the frame the map started at.
   const std::string one_stats = test::readFile(dir_->file("unit.json"));
-  EXPECT_EQ(jsonInt(one_stats, "frames_unknown_scale"),
-            jsonInt(one_stats, "tracking") + jsonInt(one_stats, "interpolated_before_initialization"))
+  EXPECT_EQ(jsonInt(one_stats, "map_starts_posed_afterwards"), 1) << one_stats;
+  EXPECT_EQ(jsonInt(one_stats, "frames_unknown_scale"), jsonInt(one_stats, "tracking") +
+                                                            jsonInt(one_stats, "interpolated_before_initialization") +
+                                                            jsonInt(one_stats, "map_starts_posed_afterwards"))
       << one_stats;
   EXPECT_GT(jsonInt(one_stats, "frames_unknown_scale"), 20) << one_stats;
   ASSERT_EQ(test::runCommand(common, &pair), 0) << pair;
@@ -218,5 +223,40 @@ TEST_F(RunLayouts, AnOutputThatCannotBeWrittenFailsTheRunAndIsNamed) {
     std::string out;
     EXPECT_EQ(test::runCommand(run + " " + option + " /dev/full", &out), 2) << option << ": " << out;
     EXPECT_NE(out.find("/dev/full"), std::string::npos) << option << ": " << out;
+  }
+}
+
+// After a loss that lasts, one camera starts a new map from two frames; the frames from its reference to its start
+// had no pose of their own and are written afterwards, from the new map's keyframes, where the rig was: the
+// trajectory has no jump there (they were written at the origin when the reference's keyframe pose was not used).
+TEST(RunBackfill, ANewMapFromTwoFramesAfterALossWritesItsFirstFramesWhereTheRigWas) {
+  test::TempDir dir("run_backfill");
+  std::string out;
+  ASSERT_EQ(test::runCommand(bin("mcslam-sim") + " --rig " + test::dataPath("calib/rectified_stereo_camchain.yaml") +
+                                 " --world indoor --frames 140 --no-depth --quiet --seed 3 --out " + dir.file("asl"),
+                             &out),
+            0)
+      << out;
+  {
+    std::ofstream config(dir.file("no_places.yaml"));
+    config << "slam:\n  places:\n    enabled: false\n";  // no relocalization: the loss ends in a new map
+  }
+  ASSERT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir.file("asl") +
+                                 " --cameras 0 --black 40-50 --quiet --config " + dir.file("no_places.yaml") +
+                                 " --out " + dir.file("t.tum") + " --stats " + dir.file("t.json"),
+                             &out),
+            0)
+      << out;
+  const std::string stats = test::readFile(dir.file("t.json"));
+  ASSERT_EQ(jsonInt(stats, "map_starts_posed_afterwards"), 2) << stats;  // the first map, and the one after the loss
+  const Trajectory t = readTumTrajectory(dir.file("t.tum"));
+  ASSERT_GT(t.size(), 100u);
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < t.size(); ++i) steps.push_back((t[i].T_w_b.t - t[i - 1].T_w_b.t).norm());
+  std::vector<double> sorted = steps;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    EXPECT_LT(steps[i], 4 * median) << "between poses " << i << " and " << i + 1 << " (median step " << median << ")";
   }
 }

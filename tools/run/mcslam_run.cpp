@@ -271,15 +271,13 @@ double runFrames(SlamPipeline& pipeline, const Dataset& ds, const std::vector<st
     console.frameError(i, tag.error);
     const PipelineTiming& timing = pipeline.timing();
     if (report.add(pose, timing)) console.stateChanged(i, pose, pipeline.cameras());
-    const bool initialized = pipeline.initialized();
-    if (initialized && !was_initialized && pipeline.initializationReference() >= 0) {
-      report.backfill(static_cast<uint64_t>(pipeline.initializationReference()), i);
-    }
-    was_initialized = initialized;
+    const bool map_started = pipeline.initialized() && !was_initialized;
+    if (map_started) report.backfill(pipeline.initialization(), i);
+    was_initialized = pipeline.initialized();
     if (pipeline.stats().scale_converged_frame == static_cast<int64_t>(i) && pose.valid) {
       console.scaleFound(i, pipeline.stats().combined_scale_sigma);
     }
-    if (pose.is_keyframe) {
+    if (pose.is_keyframe || map_started) {  // a start from two frames is seen a frame after its keyframe
       pipeline.keyframes(keyframes);
       report.noteKeyframes(keyframes);
     }

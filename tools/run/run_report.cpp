@@ -24,10 +24,18 @@ bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
   return changed;
 }
 
-void RunReport::backfill(uint64_t reference_index, uint64_t init_index) {
-  if (init_index >= frames_.size() || reference_index >= init_index) return;
-  const SE3 a = frames_[reference_index].pose.valid ? frames_[reference_index].pose.T_w_b : SE3();
-  const SE3 b = frames_[init_index].pose.T_w_b;
+void RunReport::backfill(const Odometry::InitializationSpan& start, uint64_t seen_index) {
+  if (start.reference < 0 || start.start <= start.reference || seen_index >= frames_.size() ||
+      static_cast<uint64_t>(start.start) >= seen_index)
+    return;
+  const auto reference_index = static_cast<uint64_t>(start.reference);
+  const auto init_index = static_cast<uint64_t>(start.start);
+  frames_[init_index].pose.T_w_b = start.T_w_start;
+  frames_[init_index].pose.valid = true;
+  frames_[init_index].map_start = true;
+  frames_[init_index].unknown_scale = frames_[seen_index].unknown_scale;
+  const SE3 a = start.T_w_reference;
+  const SE3 b = start.T_w_start;
   frames_[reference_index].pose.T_w_b = a;
   frames_[reference_index].pose.valid = true;
   const Vec6 xi = (a.inverse() * b).log();
@@ -101,7 +109,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   if (!out) throw InputError(path + ": cannot write stats file");
   std::vector<double> features, tracking, optimization, place_memory, total;
   uint64_t state_count[4] = {0, 0, 0, 0};
-  int interpolated = 0, unknown_scale = 0, unanchored = 0;
+  int interpolated = 0, map_starts = 0, unknown_scale = 0, unanchored = 0;
   for (const FrameRecord& r : frames_) {
     features.push_back(r.timing.features_ms);
     tracking.push_back(r.timing.tracking_ms);
@@ -110,6 +118,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     total.push_back(r.timing.total_ms);
     ++state_count[static_cast<int>(r.pose.state)];
     interpolated += r.interpolated ? 1 : 0;
+    map_starts += r.map_start ? 1 : 0;
     unknown_scale += r.unknown_scale ? 1 : 0;
     unanchored += r.pose.unanchored ? 1 : 0;
   }
@@ -142,6 +151,9 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   }
   j.endArray();
   j.key("interpolated_before_initialization").value(interpolated);
+  // Frames a map from two frames started at: published as not initialized (their attempt was taken at the next
+  // frame), written to the trajectory with their keyframe's pose.
+  j.key("map_starts_posed_afterwards").value(map_starts);
   // A rig without overlap starts up to scale: its poses have an arbitrary unit until the back-end's window
   // fixes the scale (frame of convergence; -1: the map started metric, or never converged). One camera's
   // poses are all up to scale (frames_unknown_scale counts them).

@@ -15,6 +15,7 @@ struct FrameRecord {
   PoseEstimate pose;
   PipelineTiming timing;
   bool interpolated = false;   // filled in after a two-frame initialization
+  bool map_start = false;      // a two-frame map started here, published as not initialized, its pose filled in
   bool unknown_scale = false;  // its position is not in metres (one camera; a rig without overlap before its scale)
 };
 
@@ -37,9 +38,10 @@ class RunReport {
  public:
   // Returns true when the frame's tracking state differs from the previous frame's (see stateChanges()).
   bool add(const PoseEstimate& pose, const PipelineTiming& timing);
-  // After a two-frame initialization at frame `init_index` from reference frame `reference_index`, the
-  // frames in between get poses interpolated between the two (they had none of their own).
-  void backfill(uint64_t reference_index, uint64_t init_index);
+  // A map started from two frames (SlamPipeline::initialization()): the reference frame and the start frame get the
+  // poses of their keyframes (the start was published as not initialized: its attempt is taken at the next frame,
+  // `seen_index`), and the frames between get poses interpolated between the two (they had none of their own).
+  void backfill(const Odometry::InitializationSpan& start, uint64_t seen_index);
   // The keyframes in the map now, with their latest optimized poses (a keyframe that left the map keeps its last).
   void noteKeyframes(const std::vector<KeyframePose>& keyframes);
   // The last frame that was tracked had no metric scale (one camera; a rig without overlap before its scale).

@@ -53,6 +53,7 @@ struct OdometryTiming {
 };
 
 class ExtrinsicCheck;
+class InitializationAttempt;
 class Initializer;
 class LocalMapper;
 class ScaleSupervisor;
@@ -121,17 +122,29 @@ class Odometry {
   double unitSigma() const;
   // Heap allocations made so far on the back-end thread and the scale estimate's (0 when they run inline).
   uint64_t backendThreadAllocations() const;
-  // Frame index of the reference frame of the last initialization when it used two frames (the frames
-  // between the two have no estimate of their own), -1 when it used one frame.
-  int64_t lastInitializationReference() const { return last_init_reference_; }
+  // Set by the process() that started a map from two frames, until the next process() of an uninitialized frame:
+  // the reference frame and the frame the map started at (both -1 otherwise), and their poses in this odometry's
+  // frame. The frames between them have no estimate of their own, and the start frame was published as not
+  // initialized (its attempt is taken at the next frame, the first tracked).
+  struct InitializationSpan {
+    int64_t reference = -1;
+    int64_t start = -1;
+    SE3 T_w_reference;
+    SE3 T_w_start;
+  };
+  const InitializationSpan& lastInitialization() const { return last_init_; }
 
  private:
-  // The initialize state: a map from one frame (enough metric multi-view features) or from two.
-  void initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
+  // The initialize state: a map from one frame (enough metric multi-view features) or from two, the second being
+  // the last frame, whose attempt ran beside this one (InitializationAttempt). True when the map started from the
+  // last frame: this frame is still to be tracked on it.
+  bool initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
+  bool startFromAttempt();  // the last frame's attempt succeeded and its map started
   int initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_index);  // keyframe slot, -1: not yet
-  int initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, bool& metric);
-  // The map starts at keyframe `kf_new`: the track state.
-  void startMap(int kf_new, uint64_t frame_index, bool metric, PoseEstimate& out, bool new_map = true);
+  int initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_ref_cur, bool& metric);
+  // The map starts at keyframe `kf_new` of frame `frame_index`: the track state.
+  void startMap(int kf_new, uint64_t frame_index, bool metric, bool new_map = true);
+  void publishStart(PoseEstimate& out);  // the frame the map started at is its first keyframe, tracked
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.
   void lose(uint64_t frame_index, int inliers, PoseEstimate& out);
@@ -166,6 +179,7 @@ class Odometry {
   Map map_;
   std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<Initializer> initializer_;
+  std::unique_ptr<InitializationAttempt> attempt_;  // after the initializer: its job uses it
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<TemporalTriangulator> triangulator_;
   std::unique_ptr<WindowBridge> bridge_;
@@ -185,7 +199,7 @@ class Odometry {
   int settled_count_ = 0;
   std::array<Rescale, 4> rescales_{};
   int rescale_count_ = 0;
-  int64_t last_init_reference_ = -1;
+  InitializationSpan last_init_;
   uint64_t frame_index_ = 0;  // of the frame being processed
   OdometryStats stats_;
   OdometryTiming timing_;

@@ -84,7 +84,8 @@ struct OdometryOptions {
   // The solve runs on a thread of its own while tracking goes on with the next frames; its result is applied at a
   // fixed frame, so the output does not depend on timing. A keyframe's own pose is then the tracked one (the
   // optimized pose is what the following frames continue from). The scale estimate of a map started up to scale
-  // runs on a thread of its own with it, taken at the next settled keyframe (see `repeatable`).
+  // runs on a thread of its own with it, taken at the next settled keyframe (see `repeatable`), and so does each
+  // two-frame initialization attempt, taken at the next frame (InitializationAttempt).
   bool backend_thread = true;
   // true: the scale estimate is taken at the settled keyframe after the one that started it, waiting for it if need
   // be, so that runs repeat exactly (mcslam-run); false: at the first settled keyframe that finds it done, so that

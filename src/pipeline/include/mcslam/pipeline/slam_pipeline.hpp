@@ -46,8 +46,9 @@ class SlamPipeline final : public FrameProcessor {
   uint64_t rejectedImages() const { return front_end_.rejectedImages(); }
   int cameras() const { return rig_.size(); }
   bool initialized() const { return odometry_.initialized(); }
-  // The frame the map was last initialized from (its sequence number), -1 before the first initialization.
-  int64_t initializationReference() const { return odometry_.lastInitializationReference(); }
+  // The start of a map from two frames seen by the last frame (Odometry::lastInitialization()), its poses in the
+  // world frame of the poses published; none when that frame has no place in the world (localizing in a map).
+  const Odometry::InitializationSpan& initialization() const { return initialization_; }
   // The keyframes in the map now (appended to `out`, which is cleared first): with place memory every keyframe of
   // the place map in the world frame (loop-corrected), else the odometry's local map.
   void keyframes(std::vector<KeyframePose>& out) const;
@@ -64,6 +65,7 @@ class SlamPipeline final : public FrameProcessor {
   // of `timing` (features_ms; tracking_ms and optimization_ms).
   void computeFeatures(const RigFrameView& frame, FrameFeatures& out, PipelineTiming& timing);
   void track(const FrameFeatures& features, uint64_t sequence, Timestamp t, PoseEstimate& out, PipelineTiming& timing);
+  void noteInitialization();
 
   Rig rig_;
   PipelineConfig config_;
@@ -73,6 +75,7 @@ class SlamPipeline final : public FrameProcessor {
   std::unique_ptr<PlaceMemory> places_;
   FrameFeatures features_;
   PipelineTiming timing_;
+  Odometry::InitializationSpan initialization_;
   struct Stage {
     FrameFeatures features;
     uint64_t sequence = 0;
