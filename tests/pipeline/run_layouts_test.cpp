@@ -226,30 +226,47 @@ TEST_F(RunLayouts, AnOutputThatCannotBeWrittenFailsTheRunAndIsNamed) {
   }
 }
 
+// One camera of a rendered pair (140 frames), 4 s of a loop: long enough for a loss that lasts.
+class RunAfterALoss : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<test::TempDir>("run_after_loss");
+    std::string out;
+    ASSERT_EQ(
+        test::runCommand(bin("mcslam-sim") + " --rig " + test::dataPath("calib/rectified_stereo_camchain.yaml") +
+                             " --world indoor --frames 140 --no-depth --quiet --seed 3 --out " + dir_->file("asl"),
+                         &out),
+        0)
+        << out;
+    std::ofstream config(dir_->file("no_places.yaml"));
+    config << "slam:\n  places:\n    enabled: false\n";  // no relocalization: a loss ends in a new map
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+
+  // mcslam-run on camera 0 with `options`; the stats file's text.
+  static std::string run(const std::string& tag, const std::string& options) {
+    std::string out;
+    EXPECT_EQ(
+        test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --cameras 0 --quiet " + options +
+                             " --out " + dir_->file(tag + ".tum") + " --stats " + dir_->file(tag + ".json"),
+                         &out),
+        0)
+        << out;
+    return test::readFile(dir_->file(tag + ".json"));
+  }
+
+  static std::unique_ptr<test::TempDir> dir_;
+};
+
+std::unique_ptr<test::TempDir> RunAfterALoss::dir_;
+
 // After a loss that lasts, one camera starts a new map from two frames; the frames from its reference to its start
 // had no pose of their own and are written afterwards, from the new map's keyframes, where the rig was: the
 // trajectory has no jump there (they were written at the origin when the reference's keyframe pose was not used).
-TEST(RunBackfill, ANewMapFromTwoFramesAfterALossWritesItsFirstFramesWhereTheRigWas) {
-  test::TempDir dir("run_backfill");
-  std::string out;
-  ASSERT_EQ(test::runCommand(bin("mcslam-sim") + " --rig " + test::dataPath("calib/rectified_stereo_camchain.yaml") +
-                                 " --world indoor --frames 140 --no-depth --quiet --seed 3 --out " + dir.file("asl"),
-                             &out),
-            0)
-      << out;
-  {
-    std::ofstream config(dir.file("no_places.yaml"));
-    config << "slam:\n  places:\n    enabled: false\n";  // no relocalization: the loss ends in a new map
-  }
-  ASSERT_EQ(test::runCommand(bin("mcslam-run") + " --dataset " + dir.file("asl") +
-                                 " --cameras 0 --black 40-50 --quiet --config " + dir.file("no_places.yaml") +
-                                 " --out " + dir.file("t.tum") + " --stats " + dir.file("t.json"),
-                             &out),
-            0)
-      << out;
-  const std::string stats = test::readFile(dir.file("t.json"));
+TEST_F(RunAfterALoss, ANewMapFromTwoFramesWritesItsFirstFramesWhereTheRigWas) {
+  const std::string stats = run("new_map", "--black 40-50 --config " + dir_->file("no_places.yaml"));
   ASSERT_EQ(jsonInt(stats, "map_starts_posed_afterwards"), 2) << stats;  // the first map, and the one after the loss
-  const Trajectory t = readTumTrajectory(dir.file("t.tum"));
+  const Trajectory t = readTumTrajectory(dir_->file("new_map.tum"));
   ASSERT_GT(t.size(), 100u);
   std::vector<double> steps;
   for (std::size_t i = 1; i < t.size(); ++i) steps.push_back((t[i].T_w_b.t - t[i - 1].T_w_b.t).norm());
@@ -259,4 +276,16 @@ TEST(RunBackfill, ANewMapFromTwoFramesAfterALossWritesItsFirstFramesWhereTheRigW
   for (std::size_t i = 0; i < steps.size(); ++i) {
     EXPECT_LT(steps[i], 4 * median) << "between poses " << i << " and " << i + 1 << " (median step " << median << ")";
   }
+}
+
+// A loss longer than place memory's timeout sends the odometry back to initialization, and the first frame after
+// the blackout both starts an attempt and is relocalized: the relocalization drops the attempt in flight and the
+// rig is tracked from there to the end in the same map.
+TEST_F(RunAfterALoss, ARelocalizationDropsTheInitializationAttemptInFlight) {
+  const std::string stats = run("relocalized", "--black 40-80");
+  EXPECT_EQ(jsonInt(stats, "relocalizations"), 1) << stats;
+  EXPECT_EQ(jsonInt(stats, "last_relocalized_frame"), 81) << stats;
+  EXPECT_EQ(jsonInt(stats, "initializations"), 1) << stats;  // the first map only
+  // The 59 frames from the relocalization on, and the first map's before the blackout.
+  EXPECT_GE(jsonInt(stats, "tracking"), 59 + 10) << stats;
 }
