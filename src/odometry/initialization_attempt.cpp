@@ -28,8 +28,7 @@ void InitializationAttempt::submit(const FrameFeatures& frame, uint64_t frame_in
 
 Initializer::TwoFrame InitializationAttempt::collect(SE3& T_ref_cur) {
   if (!pending_) return Initializer::TwoFrame::Waiting;
-  if (task_) task_->collect();
-  pending_ = false;
+  cancel();  // waits for it; its result stays in the job
   T_ref_cur = job_.T_ref_cur;
   return job_.result;
 }

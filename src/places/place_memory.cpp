@@ -66,13 +66,9 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
              (!map_.placed(segment_) || (localize_only_ && out.is_keyframe))) {
     place(frame, frame_index, odometry, out.T_w_b);
   }
-  if (out.valid && segment_ >= 0) {
-    if (map_.placed(segment_)) {
-      out.T_w_b = map_.toWorld(segment_, out.T_w_b);
-    } else {
-      out.valid = false;
-      out.state = TrackingState::Localizing;
-    }
+  if (out.valid && !toWorld(out.T_w_b, out.T_w_b)) {
+    out.valid = false;
+    out.state = TrackingState::Localizing;
   }
   out.world_revision = world_revision_;
   out.unanchored = out.valid && segment_ >= 0 && !anchored_[static_cast<std::size_t>(segment_)];

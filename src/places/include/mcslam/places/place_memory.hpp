@@ -46,7 +46,7 @@ class PlaceMemory {
 
   // After odometry.process(frame, frame_index, out): see above. `out` ends in the world frame.
   void afterOdometry(const FrameFeatures& frame, uint64_t frame_index, Odometry& odometry, PoseEstimate& out);
-  // A pose of the odometry's current map in the world frame, as afterOdometry() moved the last frame's; false while
+  // A pose of the odometry's current map in the world frame (afterOdometry() moves the frame's with it); false while
   // that map has no place in the world yet (localizing in a loaded map).
   bool toWorld(const SE3& T_o_b, SE3& T_w_b) const;
   // Takes the loop closer's work still in flight (a detection, then a correction) into the map (after the last
