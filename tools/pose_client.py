@@ -24,6 +24,7 @@ FLAG_VALID = 1
 FLAG_KEYFRAME = 2
 FLAG_UNSCALED = 4  # position in an arbitrary unit, not metres
 FLAG_UNANCHORED = 8  # the pose's place in the world is a guess since an unbridged loss (docs/pose-protocol.md)
+FLAG_ROUGHLY_METRIC = 16  # with FLAG_UNSCALED: metres, but from points too far for the cameras' baseline
 
 
 def decode(data):
@@ -45,6 +46,7 @@ def decode(data):
         "tracking": TRACKING.get(state, "unknown"),
         "valid": bool(flags & FLAG_VALID), "keyframe": bool(flags & FLAG_KEYFRAME),
         "unscaled": bool(flags & FLAG_UNSCALED), "unanchored": bool(flags & FLAG_UNANCHORED),
+        "roughly_metric": bool(flags & FLAG_ROUGHLY_METRIC),
         "quality": quality, "world_revision": world_revision,
     }
 

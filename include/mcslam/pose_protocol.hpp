@@ -26,6 +26,10 @@ inline constexpr uint8_t kFlagUnscaled = 1u << 2;
 // new map is not yet joined to the old one. Poses are consistent among themselves; the flag clears, with
 // world_revision one higher, when a recognized place joins the maps (the pose then jumps by the correction).
 inline constexpr uint8_t kFlagUnanchored = 1u << 3;
+// Set with kFlagUnscaled: the unit is the metre as the rig's overlapping cameras measure it from points too far for
+// their baseline (cameras centimetres apart, a far scene), and lengths can be tens of percent off; it clears with
+// kFlagUnscaled once the rig sees enough near points. Readers before it was defined see only kFlagUnscaled.
+inline constexpr uint8_t kFlagRoughlyMetric = 1u << 4;
 
 struct PoseRecord {
   uint64_t sequence = 0;                 // publish counter, 1 for the first pose of a daemon run, +1 per pose
@@ -46,6 +50,7 @@ struct PoseRecord {
   bool keyframe() const { return (flags & kFlagKeyframe) != 0; }
   bool unscaled() const { return (flags & kFlagUnscaled) != 0; }
   bool unanchored() const { return (flags & kFlagUnanchored) != 0; }
+  bool roughlyMetric() const { return (flags & kFlagRoughlyMetric) != 0; }
 };
 
 enum class DecodeStatus { Ok, TooShort, BadMagic, BadVersion, BadSize };

@@ -185,6 +185,7 @@ DaemonStats Daemon::stats() const {
   s.trajectory_errno = publishing_.trajectory().lastErrno();
   s.tracking = processing_.tracking();
   s.unscaled = processing_.unscaled();
+  s.roughly_metric = processing_.roughlyMetric();
   s.latency_count = publishing_.latency().count();
   s.latency_p50_ns = publishing_.latency().percentileNs(0.5);
   s.latency_p99_ns = publishing_.latency().percentileNs(0.99);

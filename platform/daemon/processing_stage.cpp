@@ -124,6 +124,7 @@ void ProcessingStage::handOver(PoseSlot& out, const FrameTag& tag) {
   if (out_.publish()) pose_drops_.fetch_add(1, std::memory_order_relaxed);
   tracking_.store(static_cast<uint8_t>(out.estimate.state), std::memory_order_relaxed);
   unscaled_.store(out.estimate.valid && !out.estimate.metric, std::memory_order_relaxed);
+  roughly_metric_.store(out.estimate.valid && out.estimate.roughly_metric, std::memory_order_relaxed);
   afterFrame();
   const uint64_t done = processed_.fetch_add(1, std::memory_order_release) + 1;
   pressure_.done();

@@ -73,7 +73,8 @@ void PublishingStage::publish(const PoseSlot& slot) {
   r.orientation[3] = q.w();
   r.tracking = static_cast<pose::Tracking>(e.state);
   r.flags = static_cast<uint8_t>((e.valid ? pose::kFlagValid : 0) | (e.is_keyframe ? pose::kFlagKeyframe : 0) |
-                                 (e.metric ? 0 : pose::kFlagUnscaled) | (e.unanchored ? pose::kFlagUnanchored : 0));
+                                 (e.metric ? 0 : pose::kFlagUnscaled) | (e.unanchored ? pose::kFlagUnanchored : 0) |
+                                 (e.roughly_metric ? pose::kFlagRoughlyMetric : 0));
   r.quality = e.quality;
   r.world_revision = e.world_revision;
   if (shm_) shm_->publish(r);

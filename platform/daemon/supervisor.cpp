@@ -21,6 +21,16 @@
 
 namespace mcslam::platform {
 
+namespace {
+
+const char* unitNote(const DaemonStats& s) {
+  if (!s.unscaled) return "";
+  return s.roughly_metric ? " (roughly metric: the cameras see their common points too far for their baseline)"
+                          : " (up to scale)";
+}
+
+}  // namespace
+
 void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char* out, std::size_t size) {
   const double per_frame = s.frames_after_warmup ? static_cast<double>(s.allocations_after_warmup) /
                                                        static_cast<double>(s.frames_after_warmup)
@@ -30,11 +40,11 @@ void formatStatus(const DaemonStats& s, double rate_hz, const char* health, char
       "%.1f Hz, %s%s, frames %llu, dropped %llu, partial %llu, latency p50 %.1f ms, allocs/frame %.2f%s, "
       "cameras %s%s, map %lld keyframes (culled %llu), relocalizations %llu, loop closures %llu, merges %llu, "
       "world revision %u, map saves %llu (failed %llu)",
-      rate_hz, trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "",
-      static_cast<unsigned long long>(s.processed), static_cast<unsigned long long>(s.rig_drops + s.camera_drops),
-      static_cast<unsigned long long>(s.partial_frames), static_cast<double>(s.latency_p50_ns) * 1e-6, per_frame,
-      s.warm ? "" : " (warming up)", health, s.source_finished ? ", source finished" : "",
-      static_cast<long long>(s.places.keyframes), static_cast<unsigned long long>(s.places.keyframes_culled),
+      rate_hz, trackingStateName(s.tracking), unitNote(s), static_cast<unsigned long long>(s.processed),
+      static_cast<unsigned long long>(s.rig_drops + s.camera_drops), static_cast<unsigned long long>(s.partial_frames),
+      static_cast<double>(s.latency_p50_ns) * 1e-6, per_frame, s.warm ? "" : " (warming up)", health,
+      s.source_finished ? ", source finished" : "", static_cast<long long>(s.places.keyframes),
+      static_cast<unsigned long long>(s.places.keyframes_culled),
       static_cast<unsigned long long>(s.places.relocalizations),
       static_cast<unsigned long long>(s.places.loop_closures), static_cast<unsigned long long>(s.places.map_merges),
       static_cast<unsigned>(s.places.world_revision), static_cast<unsigned long long>(s.map_saves),
@@ -134,7 +144,7 @@ class Watch {
       if (s.tracking == TrackingState::Lost)
         spdlog::warn("tracking lost (frame {})", s.processed);
       else
-        spdlog::info("tracking state: {}{}", trackingStateName(s.tracking), s.unscaled ? " (up to scale)" : "");
+        spdlog::info("tracking state: {}{}", trackingStateName(s.tracking), unitNote(s));
       last_state_ = s.tracking;
     } else if (last_unscaled_ && !s.unscaled && s.tracking == TrackingState::Tracking) {
       spdlog::info("metric scale found (by frame {}): positions are in metres from here on", s.processed);

@@ -1,6 +1,7 @@
 #include "mcslam/odometry/initializer.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -22,6 +23,34 @@ int Initializer::usableMultiView(const FrameFeatures& f, double max_depth_sigma)
   int n = 0;
   for (int t = 0; t < f.mv_count; ++t)
     n += f.mv[t].has_point && f.mv[t].relative_depth_sigma <= max_depth_sigma ? 1 : 0;
+  return n;
+}
+
+double Initializer::multiViewDisparityPx(const FrameFeatures& f, int t, const Rig& rig) {
+  const MultiViewFeature& mv = f.mv[t];
+  double widest = 0;
+  for (int a = 0; a < mv.size; ++a) {
+    const int ca = f.mv_refs[mv.first + a].cam;
+    const Vec3 ray_a = (mv.p_b - rig.T_b_c(ca).t).normalized();
+    for (int b = a + 1; b < mv.size; ++b) {
+      const int cb = f.mv_refs[mv.first + b].cam;
+      const Vec3 ray_b = (mv.p_b - rig.T_b_c(cb).t).normalized();
+      const double focal = 0.5 * (rig.model(ca).fx() + rig.model(cb).fx());
+      widest = std::max(widest, std::acos(std::clamp(ray_a.dot(ray_b), -1.0, 1.0)) * focal);
+    }
+  }
+  return widest;
+}
+
+int Initializer::metricMultiView(const FrameFeatures& f, const Rig& rig, double max_depth_sigma,
+                                 double min_disparity_px) {
+  int n = 0;
+  for (int t = 0; t < f.mv_count; ++t) {
+    const MultiViewFeature& mv = f.mv[t];
+    if (mv.has_point && mv.relative_depth_sigma <= max_depth_sigma &&
+        multiViewDisparityPx(f, t, rig) >= min_disparity_px)
+      ++n;
+  }
   return n;
 }
 

@@ -79,6 +79,7 @@ void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEst
   processFrame(frame, frame_index, out);
   // As of the end of the frame: a scale that converged in it already rescaled this pose.
   out.metric = bridge_->rigState().metric();
+  out.roughly_metric = bridge_->rigState().scale() == ScaleStatus::Uncertain;
 }
 
 void Odometry::processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
@@ -181,6 +182,8 @@ void Odometry::lose(uint64_t frame_index, int inliers, PoseEstimate& out) {
 void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers,
                             PoseEstimate& out) {
   const auto map_start = Clock::now();
+  if (bridge_->rigState().scale() == ScaleStatus::Uncertain && seesMetricPoints(frame))
+    unitBecomesMetric(frame, frame_index);
   const int slot = mapper_->insertKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, &tracker_->matches(),
                                            T_w_b, frame_index);
   if (slot < 0) return;
@@ -200,6 +203,21 @@ void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, co
   } else if (!options_.backend_thread) {
     flush();  // the solve ran inline: apply it now, as before the back-end had a thread
   }
+}
+
+void Odometry::unitBecomesMetric(const FrameFeatures& frame, uint64_t frame_index) {
+  // No solve is in flight here (a keyframe's flushes the one before it): the window may let the unit go, and the
+  // metric points this keyframe brings pull it to the metre as a metric start's do.
+  bridge_->setScaleStatus(ScaleStatus::Metric);
+  bridge_->holdScale(false);
+  triangulator_->setSceneReferencedPoints(false);
+  apply_after_frames_ = options_.backend_apply_after_frames;
+  tracker_->unitLeavesWindow();
+  stats_.scale_converged_frame = static_cast<int64_t>(frame_index);
+  spdlog::info(
+      "odometry: frame {}: the map's unit is the metre from now on ({} multi-view points at {} px of "
+      "disparity or more)",
+      frame_index, metricMultiView(frame), options_.metric_disparity_px);
 }
 
 void Odometry::mapNow(int slot, uint64_t frame_index, int inliers, Clock::time_point map_start) {
@@ -297,7 +315,7 @@ bool Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
   if (initializer_->oneFrameReady(frame)) {
     const int kf_new = initializeFromOneFrame(frame, frame_index);
     if (kf_new >= 0) {
-      startMap(kf_new, frame_index, /*metric=*/true);
+      startMap(kf_new, frame_index, startScale(frame, /*overlap=*/true));
       publishStart(out);
       return false;
     }
@@ -311,11 +329,10 @@ bool Odometry::initialize(const FrameFeatures& frame, uint64_t frame_index, Pose
 bool Odometry::startFromAttempt() {
   SE3 T_ref_cur;
   if (attempt_->collect(T_ref_cur) != Initializer::TwoFrame::Ready) return false;
-  bool metric = true;
   const uint64_t start_index = attempt_->frameIndex();
-  const int kf_new = initializeFromTwoFrames(attempt_->frame(), start_index, T_ref_cur, metric);
+  const int kf_new = initializeFromTwoFrames(attempt_->frame(), start_index, T_ref_cur);
   if (kf_new < 0) return false;
-  startMap(kf_new, start_index, metric);
+  startMap(kf_new, start_index, startScale(attempt_->frame(), initializer_->lastMetric()));
   last_init_.start = static_cast<int64_t>(start_index);
   last_init_.T_w_start = tracker_->pose();
   return true;
@@ -330,8 +347,7 @@ int Odometry::initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_
   return kf_new;
 }
 
-int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_ref_cur,
-                                      bool& metric) {
+int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_ref_cur) {
   const auto map_start = Clock::now();
   const FrameFeatures& ref = initializer_->reference();
   const uint64_t ref_index = initializer_->referenceIndex();
@@ -353,26 +369,39 @@ int Odometry::initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame
   timing_.backend_ms = msSince(be_start);
   last_init_.reference = static_cast<int64_t>(ref_index);
   last_init_.T_w_reference = map_.keyframe(kf_ref).T_w_b;
-  // One camera: never metric, nothing to wait for.
-  metric = initializer_->lastMetric() || bridge_->rigState().cameras() == 1;
   return kf_new;
 }
 
-void Odometry::startMap(int kf_new, uint64_t frame_index, bool metric, bool new_map) {
-  const int cams = bridge_->rigState().cameras();
-  const bool unit_on_window = !metric || cams == 1;
+ScaleStatus Odometry::startScale(const FrameFeatures& frame, bool overlap) const {
+  if (bridge_->rigState().cameras() == 1) return ScaleStatus::Monocular;
+  if (!overlap) return ScaleStatus::Unscaled;
+  return seesMetricPoints(frame) ? ScaleStatus::Metric : ScaleStatus::Uncertain;
+}
+
+bool Odometry::seesMetricPoints(const FrameFeatures& frame) const {
+  return metricMultiView(frame) >= options_.init_min_multiview;
+}
+
+int Odometry::metricMultiView(const FrameFeatures& frame) const {
+  return Initializer::metricMultiView(frame, bridge_->rigState().rig(), options_.landmark_max_depth_sigma,
+                                      options_.metric_disparity_px);
+}
+
+void Odometry::startMap(int kf_new, uint64_t frame_index, ScaleStatus scale, bool new_map) {
+  const bool unit_on_window = scale != ScaleStatus::Metric;
   initializer_->reset();
   initialized_ = true;
-  bridge_->setScaleStatus(cams == 1 ? ScaleStatus::Monocular : metric ? ScaleStatus::Metric : ScaleStatus::Unscaled);
-  // A map that starts up to scale keeps its unit (the window holds it: OdometryOptions::hold_window_scale) and only
-  // the scale supervisor's rescales change it: a free window lets the scale random-walk wherever no turn
-  // constrains it. resetMap() lets it go.
-  if (!metric && cams > 1) bridge_->holdScale(true);
+  bridge_->setScaleStatus(scale);
+  // A map that starts up to scale, or whose unit is uncertain, keeps its unit (the window holds it:
+  // OdometryOptions::hold_window_scale) and only the scale supervisor's rescales change it: a free window lets the
+  // scale random-walk wherever nothing constrains it (no turn; cross-camera points at a pixel of disparity).
+  // resetMap() lets it go.
+  if (scale == ScaleStatus::Unscaled || scale == ScaleStatus::Uncertain) bridge_->holdScale(true);
   triangulator_->setSceneReferencedPoints(unit_on_window);
   // A map whose unit rests on its window (one camera, or no overlap before the scale is found) tracks on solved
   // maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
   apply_after_frames_ = unit_on_window ? 1 : options_.backend_apply_after_frames;
-  scale_->start(!metric);
+  scale_->start(scale == ScaleStatus::Unscaled);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
   ++stats_.keyframes;
   tracker_->startFrom(map_, kf_new, frame_index, unit_on_window);  // from the landmarks of the new keyframe
@@ -408,7 +437,7 @@ void Odometry::relocalize(const FrameFeatures& frame, uint64_t frame_index, cons
   out = PoseEstimate{};
   out.t = frame.t;
   out.sequence = frame_index;
-  startMap(kf, frame_index, status != ScaleStatus::Unscaled, /*new_map=*/false);
+  startMap(kf, frame_index, status, /*new_map=*/false);
   publishStart(out);
 }
 

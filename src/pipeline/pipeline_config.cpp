@@ -87,6 +87,7 @@ void readKeyframes(ConfigSection s, PipelineConfig& c) {
 void readInitialization(ConfigSection s, PipelineConfig& c) {
   OdometryOptions& o = c.odometry;
   s.read("min_multiview", o.init_min_multiview, 6, 100000);
+  s.read("metric_disparity_px", o.metric_disparity_px, 0.0, 10000.0);
   s.read("min_matches", o.init_min_matches, 20, 100000);
   s.read("max_reference_age", o.init_max_reference_age, 1, 100000);
   s.finish();
@@ -230,6 +231,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    translation_ratio: " << o.keyframe_translation_ratio << "\n"
      << "  initialization:\n"
      << "    min_multiview: " << o.init_min_multiview << "\n"
+     << "    metric_disparity_px: " << o.metric_disparity_px << "\n"
      << "    min_matches: " << o.init_min_matches << "\n"
      << "    max_reference_age: " << o.init_max_reference_age << "\n"
      << "  backend:\n"

@@ -151,10 +151,11 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   words_.compute(vocabulary_, kf.features);
   database_.insert(slot, words_.bow());
   ++stats_.keyframes;
-  // SE(3) closures need a metric map, Sim(3) ones (one camera) a unit that stays put between loops: a map of a
-  // rig without overlap whose unit is still being found waits for it.
+  // SE(3) closures need a metric map (or one whose uncertain unit its window holds), Sim(3) ones (one camera) a
+  // unit that stays put between loops: a map of a rig without overlap whose unit is still being found waits for it.
   const ScaleStatus scale = odometry.rigState().scale();
-  const bool closable = loop_closer_.similarity() ? scale == ScaleStatus::Monocular : scale == ScaleStatus::Metric;
+  const bool closable = loop_closer_.similarity() ? scale == ScaleStatus::Monocular
+                                                  : scale == ScaleStatus::Metric || scale == ScaleStatus::Uncertain;
   if (options_.loop_closure && closable) {
     loop_closer_.setRig(odometry.trackingRig());
     loop_closer_.startDetection(slot, kf.features, words_, map_, database_, own_points_);

@@ -11,6 +11,7 @@
 #include "mcslam/calib/calibration_io.hpp"
 #include "mcslam/core/alloc_counter.hpp"
 #include "mcslam/features/multiview_matcher.hpp"
+#include "mcslam/odometry/initializer.hpp"
 #include "mcslam/odometry/odometry.hpp"
 #include "synthetic_sequence.hpp"
 #include "test_support.hpp"
@@ -30,6 +31,7 @@ struct RunResult {
   int start_seen = -1;       // the frame that started it
   int first_metric = -1;     // first tracked frame whose pose says it is metric
   int tracked_after_metric = 0, unscaled_after_metric = 0;  // tracked frames from then on, and those not metric
+  int roughly_metric = 0;                                   // tracked frames whose unit is roughly the metre
   std::vector<float> quality;                               // per frame (0 when not tracked)
   std::vector<int> keyframe_frames;                         // frames that made a keyframe (is_keyframe)
   std::vector<int> settled_frames;                          // frames in which a keyframe was settled, one per keyframe
@@ -46,8 +48,9 @@ struct RunResult {
 // Changes frame i's features before they are processed (a camera that did not deliver, say).
 using FrameChange = std::function<void(int, FrameFeatures&)>;
 
+// `matched`: the same after the multi-view matcher, before the odometry.
 RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, bool sim3,
-                      const FrameChange& change = {}, const OdometryOptions& oo = {}) {
+                      const FrameChange& change = {}, const OdometryOptions& oo = {}, const FrameChange& matched = {}) {
   test::SyntheticSequence seq(rig, so);
   OverlapMap overlap(rig, OverlapOptions{});
   MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
@@ -64,6 +67,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
     seq.fill(i, f);
     if (change) change(i, f);
     matcher.compute(f);
+    if (matched) matched(i, f);
     PoseEstimate pose;
     alloc::ThreadScope scope;
     odo.process(f, i, pose);
@@ -87,6 +91,7 @@ RunResult runSequence(const Rig& rig, const test::SyntheticSequenceOptions& so, 
       r.estimate.push_back({pose.t, pose.T_w_b});
       if (r.first_tracked < 0) r.first_tracked = i;
       if (r.first_metric < 0 && pose.metric) r.first_metric = i;
+      r.roughly_metric += pose.roughly_metric && !pose.metric ? 1 : 0;
       if (r.first_metric >= 0) {
         ++r.tracked_after_metric;
         r.unscaled_after_metric += pose.metric ? 0 : 1;
@@ -250,6 +255,51 @@ TEST(OdometrySynthetic, Stereo) {
   EXPECT_EQ(r.tracked_after_metric, static_cast<int>(r.estimate.size())) << "a metric start: every pose in metres";
   EXPECT_EQ(r.unscaled_after_metric, 0);
   EXPECT_EQ(*std::max_element(r.unit_sigma.begin(), r.unit_sigma.end()), 0.0) << "its unit is the metre throughout";
+  if (test::countsAllocations()) {
+    EXPECT_EQ(r.allocations_after_warmup, 0u);
+  }
+}
+
+// A stereo pair that sees its common points at fewer pixels of disparity than the metric bar (here the bar is raised
+// above the synthetic stereo pair's widest disparities; KITTI's grey and colour cameras of one side, 6 cm apart,
+// see theirs at about a pixel) tracks, but no pose says it is in metres: every one says it is roughly so.
+TEST(OdometrySynthetic, CamerasThatSeeTheirCommonPointsTooFarAreNotDeclaredMetric) {
+  test::SyntheticSequenceOptions so;
+  so.frames = 80;
+  OdometryOptions oo;
+  oo.metric_disparity_px = 200;
+  const RunResult r = runSequence(test::isecRig().subset({1, 2}), so, false, {}, oo);
+  EXPECT_EQ(r.stats.lost, 0u);
+  EXPECT_EQ(r.first_tracked, 0) << "a start from one frame, as a metric one";
+  EXPECT_EQ(r.first_metric, -1) << "no pose in metres";
+  EXPECT_EQ(r.roughly_metric, static_cast<int>(r.estimate.size())) << "every one roughly so";
+  EXPECT_EQ(r.stats.scale_converged_frame, -1);
+  EXPECT_LT(r.ate, 0.08);  // SE(3): the unit is the metre here, as far as the points tell
+}
+
+// A stereo rig that starts where its common points are all far (here: for the first 40 frames, the multi-view
+// points nearer than the bar have no point) starts in roughly metric units, and its first keyframe with enough
+// points past the bar makes the map metric: every pose from there on is in metres, as accurate as a metric start's.
+TEST(OdometrySynthetic, AnUncertainUnitBecomesMetricAtTheFirstKeyframeThatSeesNearPoints) {
+  test::SyntheticSequenceOptions so;
+  constexpr int kFarUntil = 40;
+  OdometryOptions oo;
+  oo.metric_disparity_px = 20;  // the synthetic pair's points lie at 10-50 px
+  const Rig rig = test::isecRig().subset({1, 2});
+  const RunResult r = runSequence(rig, so, false, {}, oo, [&](int i, FrameFeatures& f) {
+    if (i >= kFarUntil) return;
+    for (int t = 0; t < f.mv_count; ++t)
+      if (Initializer::multiViewDisparityPx(f, t, rig) >= oo.metric_disparity_px) f.mv[t].has_point = false;
+  });
+  EXPECT_EQ(r.stats.lost, 0u);
+  EXPECT_EQ(r.first_tracked, 0) << "a start from one frame, of its far points";
+  const auto after = std::lower_bound(r.keyframe_frames.begin(), r.keyframe_frames.end(), kFarUntil);
+  ASSERT_NE(after, r.keyframe_frames.end());
+  EXPECT_EQ(r.first_metric, *after);
+  EXPECT_EQ(r.roughly_metric, r.first_metric - r.first_tracked) << "roughly metric until then";
+  EXPECT_EQ(r.stats.scale_converged_frame, *after);
+  EXPECT_EQ(r.unscaled_after_metric, 0) << "metric from then on";
+  EXPECT_LT(r.ate, 0.08);  // SE(3), as the stereo rig's metric start (OdometrySynthetic.Stereo)
   if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }

@@ -120,18 +120,29 @@ TEST_F(RunLayouts, TheRunnerSaysWhenTheTrajectoryIsNotMetric) {
   EXPECT_NE(one.find("tracking up to scale (one camera)"), std::string::npos) << one;
   EXPECT_NE(one.find("one camera: the trajectory's unit is arbitrary"), std::string::npos) << one;
   // Every frame with a pose is counted up to scale: those tracked, those interpolated before initialization and
-  // the frame the map started at.
+  // the two frames the map started from (its reference and the frame it started at).
   const std::string one_stats = test::readFile(dir_->file("unit.json"));
   EXPECT_EQ(jsonInt(one_stats, "map_starts_posed_afterwards"), 1) << one_stats;
   EXPECT_EQ(jsonInt(one_stats, "frames_unknown_scale"), jsonInt(one_stats, "tracking") +
                                                             jsonInt(one_stats, "interpolated_before_initialization") +
-                                                            jsonInt(one_stats, "map_starts_posed_afterwards"))
+                                                            2 * jsonInt(one_stats, "map_starts_posed_afterwards"))
       << one_stats;
+  EXPECT_EQ(jsonInt(one_stats, "frames_roughly_metric"), 0) << one_stats;
   EXPECT_GT(jsonInt(one_stats, "frames_unknown_scale"), 20) << one_stats;
   ASSERT_EQ(test::runCommand(common, &pair), 0) << pair;
   EXPECT_EQ(pair.find("up to scale"), std::string::npos) << pair;
   EXPECT_EQ(pair.find("unit is arbitrary"), std::string::npos) << pair;
   EXPECT_EQ(jsonInt(test::readFile(dir_->file("unit.json")), "frames_unknown_scale"), 0);
+  // The pair again, with a metric bar beyond what its common points reach (as 6 cm apart before a far scene).
+  std::string far;
+  const std::string config =
+      test::writeFile(dir_->file("far.yaml"), "slam:\n  initialization:\n    metric_disparity_px: 5000\n");
+  ASSERT_EQ(test::runCommand(common + " --config " + config, &far), 0) << far;
+  EXPECT_EQ(far.find("up to scale"), std::string::npos) << far;
+  EXPECT_NE(far.find("the trajectory's unit is the metre to within tens of percent"), std::string::npos) << far;
+  const std::string far_stats = test::readFile(dir_->file("unit.json"));
+  EXPECT_GT(jsonInt(far_stats, "frames_roughly_metric"), 20) << far_stats;
+  EXPECT_EQ(jsonInt(far_stats, "frames_roughly_metric"), jsonInt(far_stats, "frames_unknown_scale")) << far_stats;
 }
 
 // A run that gives no frame a pose (one camera cannot initialize from one frame) fails and says why, instead of

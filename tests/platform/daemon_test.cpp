@@ -412,6 +412,9 @@ TEST(DaemonStatus, TheStatusLineSaysWhenPositionsAreUpToScale) {
   s.unscaled = true;
   formatStatus(s, 10.0, "ok", line, sizeof(line));
   EXPECT_NE(std::string(line).find("tracking (up to scale)"), std::string::npos) << line;
+  s.roughly_metric = true;  // overlapping cameras whose common points lie too far for their baseline
+  formatStatus(s, 10.0, "ok", line, sizeof(line));
+  EXPECT_NE(std::string(line).find("tracking (roughly metric"), std::string::npos) << line;
 }
 
 // A pose segment made anew (another process truncated it) is in the status line, and only then.

@@ -192,7 +192,10 @@ class Console {
     // Say when the poses are not in metres (pose.metric): a rig without overlap until its scale is found.
     const char* unit = pose.state != TrackingState::Tracking || pose.metric ? ""
                        : cameras == 1                                       ? " up to scale (one camera)"
-                                      : " up to scale (no two cameras overlap: the scale is searched in turns)";
+                       : pose.roughly_metric
+                           ? " in roughly metric units (the overlapping cameras see their common points too far for "
+                             "their baseline)"
+                           : " up to scale (no two cameras overlap: the scale is searched in turns)";
     std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s%s\n", show_ ? "\r\033[K" : "", i, toSeconds(pose.t),
                  trackingStateName(pose.state), unit);
   }
@@ -302,7 +305,11 @@ void printSummary(const SlamPipeline& pipeline, const run::RunReport& report, do
                static_cast<unsigned long long>(s.frames), wall, static_cast<unsigned long long>(s.tracking),
                static_cast<unsigned long long>(s.lost), static_cast<unsigned long long>(s.not_initialized),
                static_cast<unsigned long long>(s.keyframes));
-  if (report.lastTrackedUnscaled()) {
+  if (report.lastTrackedRoughlyMetric()) {
+    std::fprintf(stderr,
+                 "mcslam-run: the overlapping cameras never saw enough points near enough for their baseline: the "
+                 "trajectory's unit is the metre to within tens of percent (evaluate it with --align sim3)\n");
+  } else if (report.lastTrackedUnscaled()) {
     std::fprintf(stderr, "mcslam-run: %s: the trajectory's unit is arbitrary (evaluate it with --align sim3)\n",
                  pipeline.cameras() == 1 ? "one camera" : "the metric scale was not found");
   }

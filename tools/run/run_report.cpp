@@ -19,7 +19,10 @@ bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
   r.timing = timing;
   const bool changed = frames_.empty() || frames_.back().pose.state != pose.state;
   if (changed) changes_.push_back(StateChange{frames_.size(), pose.t, pose.state});
-  if (pose.valid && pose.state == TrackingState::Tracking) last_tracked_unscaled_ = !pose.metric;
+  if (pose.valid && pose.state == TrackingState::Tracking) {
+    last_tracked_unscaled_ = !pose.metric;
+    last_tracked_roughly_metric_ = pose.roughly_metric;
+  }
   frames_.push_back(r);
   return changed;
 }
@@ -34,10 +37,13 @@ void RunReport::backfill(const Odometry::InitializationSpan& start, uint64_t see
   frames_[init_index].pose.valid = true;
   frames_[init_index].map_start = true;
   frames_[init_index].unknown_scale = frames_[seen_index].unknown_scale;
+  frames_[init_index].pose.roughly_metric = frames_[seen_index].pose.roughly_metric;
   const SE3 a = start.T_w_reference;
   const SE3 b = start.T_w_start;
   frames_[reference_index].pose.T_w_b = a;
   frames_[reference_index].pose.valid = true;
+  frames_[reference_index].unknown_scale = frames_[init_index].unknown_scale;
+  frames_[reference_index].pose.roughly_metric = frames_[init_index].pose.roughly_metric;
   const Vec6 xi = (a.inverse() * b).log();
   for (uint64_t i = reference_index + 1; i < init_index; ++i) {
     const double s = static_cast<double>(i - reference_index) / static_cast<double>(init_index - reference_index);
@@ -45,6 +51,7 @@ void RunReport::backfill(const Odometry::InitializationSpan& start, uint64_t see
     frames_[i].pose.valid = true;
     frames_[i].interpolated = true;
     frames_[i].unknown_scale = frames_[init_index].unknown_scale;
+    frames_[i].pose.roughly_metric = frames_[init_index].pose.roughly_metric;
   }
 }
 
@@ -109,7 +116,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   if (!out) throw InputError(path + ": cannot write stats file");
   std::vector<double> features, tracking, optimization, place_memory, total;
   uint64_t state_count[4] = {0, 0, 0, 0};
-  int interpolated = 0, map_starts = 0, unknown_scale = 0, unanchored = 0;
+  int interpolated = 0, map_starts = 0, unknown_scale = 0, roughly_metric = 0, unanchored = 0;
   for (const FrameRecord& r : frames_) {
     features.push_back(r.timing.features_ms);
     tracking.push_back(r.timing.tracking_ms);
@@ -120,6 +127,7 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     interpolated += r.interpolated ? 1 : 0;
     map_starts += r.map_start ? 1 : 0;
     unknown_scale += r.unknown_scale ? 1 : 0;
+    roughly_metric += r.unknown_scale && r.pose.roughly_metric ? 1 : 0;
     unanchored += r.pose.unanchored ? 1 : 0;
   }
   const OdometryStats& s = pipeline.stats();
@@ -156,10 +164,13 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
   j.key("map_starts_posed_afterwards").value(map_starts);
   // A rig without overlap starts up to scale: its poses have an arbitrary unit until the back-end's window
   // fixes the scale (frame of convergence; -1: the map started metric, or never converged). One camera's
-  // poses are all up to scale (frames_unknown_scale counts them).
+  // poses are all up to scale (frames_unknown_scale counts them). Overlapping cameras that see their common points
+  // too far for their baseline start in roughly metric units (counted among them, and in frames_roughly_metric)
+  // until a keyframe sees enough metric points (converged_frame).
   j.key("scale").beginObject();
   j.key("converged_frame").value(static_cast<long long>(s.scale_converged_frame));
   j.key("frames_unknown_scale").value(unknown_scale);
+  j.key("frames_roughly_metric").value(roughly_metric);
   j.key("estimates").value(s.scale_estimates);
   j.key("rescales").value(s.scale_rescales);
   j.key("last_factor").value(s.last_scale);

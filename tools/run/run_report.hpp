@@ -46,6 +46,8 @@ class RunReport {
   void noteKeyframes(const std::vector<KeyframePose>& keyframes);
   // The last frame that was tracked had no metric scale (one camera; a rig without overlap before its scale).
   bool lastTrackedUnscaled() const { return last_tracked_unscaled_; }
+  // ... and its unit was roughly the metre (PoseEstimate::roughly_metric).
+  bool lastTrackedRoughlyMetric() const { return last_tracked_unscaled_ && last_tracked_roughly_metric_; }
 
   Trajectory trajectory() const;  // every frame with a pose
   Trajectory keyframes() const;
@@ -66,6 +68,7 @@ class RunReport {
   std::map<int64_t, StampedPose> keyframes_;
   std::vector<StateChange> changes_;
   bool last_tracked_unscaled_ = false;
+  bool last_tracked_roughly_metric_ = false;
   AllocationCount allocations_;
 };
 

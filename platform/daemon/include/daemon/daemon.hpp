@@ -37,7 +37,8 @@ struct DaemonStats {
   uint64_t shm_replacements = 0;            // the pose segment was truncated by another process and made anew
   int trajectory_errno = 0, udp_errno = 0;  // the reasons of the last failed trajectory write and UDP send
   TrackingState tracking = TrackingState::NotInitialized;
-  bool unscaled = false;  // the last pose's position is not in metres (PoseEstimate::metric)
+  bool unscaled = false;        // the last pose's position is not in metres (PoseEstimate::metric)
+  bool roughly_metric = false;  // ... but roughly so (PoseEstimate::roughly_metric)
   uint64_t latency_count = 0;
   int64_t latency_p50_ns = 0, latency_p99_ns = 0;  // trigger -> published
   struct StageTime {

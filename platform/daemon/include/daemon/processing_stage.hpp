@@ -53,6 +53,7 @@ class ProcessingStage {
   }
   TrackingState tracking() const { return static_cast<TrackingState>(tracking_.load(std::memory_order_relaxed)); }
   bool unscaled() const { return unscaled_.load(std::memory_order_relaxed); }
+  bool roughlyMetric() const { return roughly_metric_.load(std::memory_order_relaxed); }
   // By the features and processing threads and the processor's own (back-end, loop correction).
   uint64_t allocationsSinceWarmup() const {
     return features_meter_.since() + processing_meter_.since() + background_meter_.since();
@@ -94,6 +95,7 @@ class ProcessingStage {
   std::atomic<uint64_t> taken_{0}, processed_{0}, pose_drops_{0};
   std::atomic<uint8_t> tracking_{0};
   std::atomic<bool> unscaled_{false};
+  std::atomic<bool> roughly_metric_{false};
   std::atomic<uint64_t> relocalizations_{0}, loop_closures_{0}, map_merges_{0}, localization_corrections_{0};
   std::atomic<int64_t> place_keyframes_{0};
   std::atomic<uint16_t> world_revision_{0};

@@ -24,14 +24,21 @@ class Initializer {
 
   // Multi-view features whose point is certain enough to become a landmark.
   static int usableMultiView(const FrameFeatures& f, double max_depth_sigma);
+  // Multi-view features whose point could become a landmark (within `max_depth_sigma`) and whose widest pair of
+  // rays meets at `min_disparity_px` or more (multiViewDisparityPx): points whose depth a systematic error of a few
+  // tenths of a pixel (calibration, rectification) moves by a few percent at most.
+  static int metricMultiView(const FrameFeatures& f, const Rig& rig, double max_depth_sigma, double min_disparity_px);
+  // The angle between the widest pair of rays of multi-view feature `t` at its point, in pixels of the two
+  // cameras' mean focal length: the disparity of that pair were it rectified.
+  static double multiViewDisparityPx(const FrameFeatures& f, int t, const Rig& rig);
   bool oneFrameReady(const FrameFeatures& f) const {
     return usableMultiView(f, options_.landmark_max_depth_sigma) >= options_.init_min_multiview;
   }
 
   enum class TwoFrame { Waiting, Ready };
   // Feeds a frame to the two-frame initialization. Ready: T_ref_cur (current body frame -> reference body
-  // frame) is set and reference() is the first frame. Its translation is metric when lastMetric(), else of
-  // arbitrary scale (unit translation of one camera).
+  // frame) is set and reference() is the first frame. Its translation is metric when lastMetric() (as metric as the
+  // frames' multi-view points), else of arbitrary scale (unit translation of one camera).
   TwoFrame feed(const FrameFeatures& f, uint64_t frame_index, SE3& T_ref_cur);
   bool lastMetric() const { return last_metric_; }
   const FrameFeatures& reference() const { return reference_; }

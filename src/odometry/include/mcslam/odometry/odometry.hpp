@@ -141,9 +141,16 @@ class Odometry {
   bool initialize(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   bool startFromAttempt();  // the last frame's attempt succeeded and its map started
   int initializeFromOneFrame(const FrameFeatures& frame, uint64_t frame_index);  // keyframe slot, -1: not yet
-  int initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_ref_cur, bool& metric);
+  int initializeFromTwoFrames(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_ref_cur);
+  // The unit of a map started at `frame`: metric when the frame holds enough metric multi-view points, uncertain
+  // when its cameras overlap but see their common points too far for that, up to scale without `overlap`.
+  ScaleStatus startScale(const FrameFeatures& frame, bool overlap) const;
+  bool seesMetricPoints(const FrameFeatures& frame) const;
+  int metricMultiView(const FrameFeatures& frame) const;  // Initializer::metricMultiView with this rig and options
+  // A keyframe of a map whose unit is uncertain sees enough metric points: from now on the map is metric.
+  void unitBecomesMetric(const FrameFeatures& frame, uint64_t frame_index);
   // The map starts at keyframe `kf_new` of frame `frame_index`: the track state.
-  void startMap(int kf_new, uint64_t frame_index, bool metric, bool new_map = true);
+  void startMap(int kf_new, uint64_t frame_index, ScaleStatus scale, bool new_map = true);
   void publishStart(PoseEstimate& out);  // the frame the map started at is its first keyframe, tracked
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.

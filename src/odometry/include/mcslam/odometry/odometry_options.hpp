@@ -46,7 +46,14 @@ struct OdometryOptions {
   double keyframe_still_share = 0.25;
 
   // Initialization.
-  int init_min_multiview = 40;      // metric multi-view features needed to initialize from one frame
+  // Multi-view features a frame needs to start a map by itself (their points known to landmark_max_depth_sigma),
+  // and that a map needs, at its start or at a later keyframe, to call its unit the metre: as many points seen at
+  // metric_disparity_px or more (Initializer::metricMultiView). Fewer, and the cameras' common points lie too far
+  // for their baseline (cameras centimetres apart, a far scene): a few tenths of a pixel of calibration or
+  // rectification error, which no pixel noise model sees, move such points' depths by tens of percent, and the map
+  // says its unit is only roughly the metre (ScaleStatus::Uncertain).
+  int init_min_multiview = 40;
+  double metric_disparity_px = 10.0;
   int init_max_reference_age = 40;  // two-frame initialization: renew the reference frame after this many frames
   int init_min_matches = 60;
   // Scale of a rig without overlap, estimated over the map's newest keyframes: the map becomes metric when the

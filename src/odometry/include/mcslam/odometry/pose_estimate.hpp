@@ -36,6 +36,9 @@ struct PoseEstimate {
   // T_w_b.t is in metres. False when its unit is arbitrary: one camera, or a rig without overlap whose map
   // started up to scale and has not yet found it.
   bool metric = true;
+  // With `metric` false: the unit is the metre as overlapping cameras measured it from points too far for their
+  // baseline (a few centimetres apart, a far scene; ScaleStatus::Uncertain): lengths can be tens of percent off.
+  bool roughly_metric = false;
   // Times the world estimate has moved so far (loop closures, map merges): a consumer that sees it change knows
   // that the jump between this pose and the one before is a correction of the world, not motion.
   uint16_t world_revision = 0;

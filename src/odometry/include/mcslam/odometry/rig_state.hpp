@@ -15,6 +15,11 @@ enum class ScaleStatus : uint8_t {
   Metric,     // the map's unit is the metre (multi-view features, or a window estimate that converged)
   Unscaled,   // a map started up to scale (rig without overlap): its unit waits for the window estimates
   Monocular,  // one camera: no metric scale to find
+  // Overlapping cameras whose common points lie too far for their baseline (a few centimetres, a far scene): the
+  // map's unit is the metre as points known to tens of percent tell it, held by the window like an unscaled
+  // map's, and not reported as metric until a keyframe sees enough metric multi-view points
+  // (OdometryOptions::init_min_multiview).
+  Uncertain,
 };
 
 class RigState {
@@ -29,7 +34,8 @@ class RigState {
   ScaleStatus scale() const { return scale_; }
   // Poses in metres (the flag PoseEstimate::metric carries).
   bool metric() const { return scale_ == ScaleStatus::Metric; }
-  // False while a map started up to scale waits for its unit; true otherwise (one camera never waits).
+  // False while a map started up to scale waits for its unit; true otherwise (one camera never waits, nor an
+  // uncertain unit: its window estimates would re-measure the same far points).
   bool scaleConverged() const { return scale_ != ScaleStatus::Unscaled; }
   uint64_t version() const { return version_; }
 

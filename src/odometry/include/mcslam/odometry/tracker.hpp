@@ -51,6 +51,8 @@ class Tracker {
   // landmarks, without velocity. `unit_on_window`: the map's unit rests on the back-end window (one camera, or a
   // start up to scale), which sets the keyframe rule (needKeyframe).
   void startFrom(const Map& map, int slot, uint64_t frame_index, bool unit_on_window);
+  // The map's uncertain unit became metric: keyframes from now on as in a map that started metric.
+  void unitLeavesWindow() { unit_on_window_ = false; }
   // The map was dropped: nothing tracked, no velocity (the pose stays).
   void reset();
   // The map took a new unit: positions about `center` times s.
@@ -101,7 +103,7 @@ class Tracker {
   bool moved_since_keyframe_ = false;    // T_w_last_ is a frame after the last keyframe, not the keyframe itself
   int last_keyframe_landmarks_ = 0;      // keypoints of the last keyframe with a landmark
   int most_tracked_since_keyframe_ = 0;  // inliers of the best frame tracked since the last keyframe
-  bool unit_on_window_ = false;          // the map started up to scale or with one camera
+  bool unit_on_window_ = false;          // the map's unit rests on the window (one camera, no overlap, uncertain)
   int expected_matches_ = 0;  // of the last frame: what the local map predicted in the images (the quality's base)
   double rotation_travelled_ = 0;
   uint64_t recoveries_ = 0;
