@@ -25,8 +25,9 @@ namespace {
 
 const char* unitNote(const DaemonStats& s) {
   if (!s.unscaled) return "";
-  return s.roughly_metric ? " (roughly metric: the cameras see their common points too far for their baseline)"
-                          : " (up to scale)";
+  return s.roughly_metric
+             ? " (roughly metric: too few of the cameras' common points are near enough for their baseline)"
+             : " (up to scale)";
 }
 
 }  // namespace

@@ -22,6 +22,10 @@ namespace mcslam {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// The unit sigma of a roughly metric map: its points were seen at under metric_disparity_px, where a few tenths of
+// a pixel of calibration error are several percent of depth, and at a pixel tens of percent. Above
+// PlaceMemory's bar for uncertain units (10%): its places are measured again as an unscaled map's are.
+constexpr double kRoughlyMetricUnitSigma = 0.25;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 }  // namespace
@@ -51,6 +55,7 @@ Rig Odometry::refinedRig() const { return bridge_->refinedRig(); }
 const RigState& Odometry::rigState() const { return bridge_->rigState(); }
 
 double Odometry::unitSigma() const {
+  if (bridge_->rigState().scale() == ScaleStatus::Uncertain) return kRoughlyMetricUnitSigma;
   const int newest = map_.newestKeyframe();
   return scale_->unitSigma(newest >= 0 ? map_.keyframe(newest).id : -1);
 }
@@ -78,6 +83,10 @@ void Odometry::clearMap() {
 void Odometry::process(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out) {
   processFrame(frame, frame_index, out);
   // As of the end of the frame: a scale that converged in it already rescaled this pose.
+  publishUnit(out);
+}
+
+void Odometry::publishUnit(PoseEstimate& out) const {
   out.metric = bridge_->rigState().metric();
   out.roughly_metric = bridge_->rigState().scale() == ScaleStatus::Uncertain;
 }
@@ -182,11 +191,12 @@ void Odometry::lose(uint64_t frame_index, int inliers, PoseEstimate& out) {
 void Odometry::makeKeyframe(const FrameFeatures& frame, uint64_t frame_index, const SE3& T_w_b, int inliers,
                             PoseEstimate& out) {
   const auto map_start = Clock::now();
-  if (bridge_->rigState().scale() == ScaleStatus::Uncertain && seesMetricPoints(frame))
-    unitBecomesMetric(frame, frame_index);
   const int slot = mapper_->insertKeyframe(map_, *bridge_, bridge_->rigState().rig(), frame, &tracker_->matches(),
                                            T_w_b, frame_index);
   if (slot < 0) return;
+  // Its near points are in the map now; its new points across time and its solve follow the metric rules.
+  if (bridge_->rigState().scale() == ScaleStatus::Uncertain && seesMetricPoints(frame))
+    unitBecomesMetric(frame, frame_index);
   if (mappingDeferrable()) {
     deferMapping(slot);
     spdlog::trace("odometry: frame {}: keyframe, {} inliers, new landmarks on the back-end thread", frame_index,
@@ -335,6 +345,10 @@ bool Odometry::startFromAttempt() {
   startMap(kf_new, start_index, startScale(attempt_->frame(), initializer_->lastMetric()));
   last_init_.start = static_cast<int64_t>(start_index);
   last_init_.T_w_start = tracker_->pose();
+  PoseEstimate unit;
+  publishUnit(unit);
+  last_init_.metric = unit.metric;
+  last_init_.roughly_metric = unit.roughly_metric;
   return true;
 }
 
@@ -398,8 +412,8 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, ScaleStatus scale, boo
   // resetMap() lets it go.
   if (scale == ScaleStatus::Unscaled || scale == ScaleStatus::Uncertain) bridge_->holdScale(true);
   triangulator_->setSceneReferencedPoints(unit_on_window);
-  // A map whose unit rests on its window (one camera, or no overlap before the scale is found) tracks on solved
-  // maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
+  // A map whose unit rests on its window (one camera, no overlap before the scale is found, roughly metric) tracks
+  // on solved maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
   apply_after_frames_ = unit_on_window ? 1 : options_.backend_apply_after_frames;
   scale_->start(scale == ScaleStatus::Unscaled);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
@@ -439,6 +453,7 @@ void Odometry::relocalize(const FrameFeatures& frame, uint64_t frame_index, cons
   out.sequence = frame_index;
   startMap(kf, frame_index, status, /*new_map=*/false);
   publishStart(out);
+  publishUnit(out);  // after process(): the record it made is replaced
 }
 
 }  // namespace mcslam

@@ -274,7 +274,8 @@ TEST(OdometrySynthetic, CamerasThatSeeTheirCommonPointsTooFarAreNotDeclaredMetri
   EXPECT_EQ(r.first_metric, -1) << "no pose in metres";
   EXPECT_EQ(r.roughly_metric, static_cast<int>(r.estimate.size())) << "every one roughly so";
   EXPECT_EQ(r.stats.scale_converged_frame, -1);
-  EXPECT_LT(r.ate, 0.08);  // SE(3): the unit is the metre here, as far as the points tell
+  EXPECT_GE(*std::min_element(r.unit_sigma.begin(), r.unit_sigma.end()), 0.1) << "its unit is not called known";
+  EXPECT_LT(r.ate, 0.02);  // SE(3): the unit is the metre here, as far as the points tell (0.0022 m)
 }
 
 // A stereo rig that starts where its common points are all far (here: for the first 40 frames, the multi-view
@@ -284,7 +285,8 @@ TEST(OdometrySynthetic, AnUncertainUnitBecomesMetricAtTheFirstKeyframeThatSeesNe
   test::SyntheticSequenceOptions so;
   constexpr int kFarUntil = 40;
   OdometryOptions oo;
-  oo.metric_disparity_px = 20;  // the synthetic pair's points lie at 10-50 px
+  oo.metric_disparity_px = 20;  // the synthetic pair's points lie at 10-50 px, most of them past 20
+  oo.init_min_multiview = 20;   // a start from the first frame's 50-odd points under the bar
   const Rig rig = test::isecRig().subset({1, 2});
   const RunResult r = runSequence(rig, so, false, {}, oo, [&](int i, FrameFeatures& f) {
     if (i >= kFarUntil) return;
@@ -299,7 +301,9 @@ TEST(OdometrySynthetic, AnUncertainUnitBecomesMetricAtTheFirstKeyframeThatSeesNe
   EXPECT_EQ(r.roughly_metric, r.first_metric - r.first_tracked) << "roughly metric until then";
   EXPECT_EQ(r.stats.scale_converged_frame, *after);
   EXPECT_EQ(r.unscaled_after_metric, 0) << "metric from then on";
-  EXPECT_LT(r.ate, 0.08);  // SE(3), as the stereo rig's metric start (OdometrySynthetic.Stereo)
+  EXPECT_GE(r.unit_sigma[static_cast<std::size_t>(*after) - 1], 0.1) << "an uncertain unit until then";
+  EXPECT_EQ(r.unit_sigma[static_cast<std::size_t>(*after)], 0.0) << "the metre from then on";
+  EXPECT_LT(r.ate, 0.02);  // SE(3), as the stereo rig's metric start (OdometrySynthetic.Stereo: 0.0070 m)
   if (test::countsAllocations()) {
     EXPECT_EQ(r.allocations_after_warmup, 0u);
   }

@@ -254,12 +254,12 @@ class RunAfterALoss : public ::testing::Test {
   }
   static void TearDownTestSuite() { dir_.reset(); }
 
-  // mcslam-run on camera 0 with `options`; the stats file's text.
-  static std::string run(const std::string& tag, const std::string& options) {
+  // mcslam-run on `cameras` (camera 0 by default) with `options`; the stats file's text.
+  static std::string run(const std::string& tag, const std::string& options, const std::string& cameras = "0") {
     std::string out;
     EXPECT_EQ(
-        test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --cameras 0 --quiet " + options +
-                             " --out " + dir_->file(tag + ".tum") + " --stats " + dir_->file(tag + ".json"),
+        test::runCommand(bin("mcslam-run") + " --dataset " + dir_->file("asl") + " --cameras " + cameras + " --quiet " +
+                             options + " --out " + dir_->file(tag + ".tum") + " --stats " + dir_->file(tag + ".json"),
                          &out),
         0)
         << out;
@@ -299,4 +299,17 @@ TEST_F(RunAfterALoss, ARelocalizationDropsTheInitializationAttemptInFlight) {
   EXPECT_EQ(jsonInt(stats, "initializations"), 1) << stats;  // the first map only
   // The 59 frames from the relocalization on, and the first map's before the blackout.
   EXPECT_GE(jsonInt(stats, "tracking"), 59 + 10) << stats;
+}
+
+// A roughly metric map (the stereo pair with a metric bar beyond its disparities) stays so through a blackout: the
+// frame relocalized in it says so like every other (its record is made anew by the relocalization).
+TEST_F(RunAfterALoss, ARelocalizedFrameOfARoughlyMetricMapSaysSo) {
+  const std::string config =
+      test::writeFile(dir_->file("far.yaml"), "slam:\n  initialization:\n    metric_disparity_px: 5000\n");
+  const std::string stats = run("roughly", "--black 40-60 --config " + config, "0,1");
+  EXPECT_GE(jsonInt(stats, "relocalizations"), 1) << stats;
+  const std::size_t posed = readTumTrajectory(dir_->file("roughly.tum")).size();
+  ASSERT_GT(posed, 100u);
+  EXPECT_EQ(jsonInt(stats, "frames_unknown_scale"), static_cast<long>(posed)) << stats;
+  EXPECT_EQ(jsonInt(stats, "frames_roughly_metric"), static_cast<long>(posed)) << stats;
 }

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <exception>
@@ -189,20 +190,27 @@ class Console {
   // Losing and regaining track are worth a line of their own (the stats file lists them all).
   void stateChanged(std::size_t i, const PoseEstimate& pose, int cameras) const {
     if (quiet_ || i == 0) return;
-    // Say when the poses are not in metres (pose.metric): a rig without overlap until its scale is found.
+    // Say when the poses are not in metres (pose.metric): a rig without overlap until its scale is found, overlapping
+    // cameras until they see enough near points.
     const char* unit = pose.state != TrackingState::Tracking || pose.metric ? ""
                        : cameras == 1                                       ? " up to scale (one camera)"
                        : pose.roughly_metric
-                           ? " in roughly metric units (the overlapping cameras see their common points too far for "
-                             "their baseline)"
+                           ? " in roughly metric units (too few of the overlapping cameras' common points are near "
+                             "enough for their baseline)"
                            : " up to scale (no two cameras overlap: the scale is searched in turns)";
     std::fprintf(stderr, "%smcslam-run: frame %zu (t = %.3f s): %s%s\n", show_ ? "\r\033[K" : "", i, toSeconds(pose.t),
                  trackingStateName(pose.state), unit);
   }
+  // `sigma`: of the window estimates that found it; not finite when a roughly metric map saw enough near points.
   void scaleFound(std::size_t i, double sigma) const {
     if (quiet_) return;
-    std::fprintf(stderr, "%smcslam-run: frame %zu: metric scale found (sigma %.1f%%)\n", show_ ? "\r\033[K" : "", i,
-                 100.0 * sigma);
+    const char* clear = show_ ? "\r\033[K" : "";
+    if (std::isfinite(sigma)) {
+      std::fprintf(stderr, "%smcslam-run: frame %zu: metric scale found (sigma %.1f%%)\n", clear, i, 100.0 * sigma);
+    } else {
+      std::fprintf(stderr, "%smcslam-run: frame %zu: metric scale found (enough common points near the cameras)\n",
+                   clear, i);
+    }
   }
   void progress(std::size_t i, double total_ms, const PoseEstimate& pose) {
     ms_avg_ = i == 0 ? total_ms : 0.95 * ms_avg_ + 0.05 * total_ms;
@@ -307,8 +315,8 @@ void printSummary(const SlamPipeline& pipeline, const run::RunReport& report, do
                static_cast<unsigned long long>(s.keyframes));
   if (report.lastTrackedRoughlyMetric()) {
     std::fprintf(stderr,
-                 "mcslam-run: the overlapping cameras never saw enough points near enough for their baseline: the "
-                 "trajectory's unit is the metre to within tens of percent (evaluate it with --align sim3)\n");
+                 "mcslam-run: the overlapping cameras never saw enough common points near enough for their baseline: "
+                 "the trajectory's unit is the metre to within tens of percent (evaluate it with --align sim3)\n");
   } else if (report.lastTrackedUnscaled()) {
     std::fprintf(stderr, "mcslam-run: %s: the trajectory's unit is arbitrary (evaluate it with --align sim3)\n",
                  pipeline.cameras() == 1 ? "one camera" : "the metric scale was not found");

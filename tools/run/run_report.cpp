@@ -33,25 +33,25 @@ void RunReport::backfill(const Odometry::InitializationSpan& start, uint64_t see
     return;
   const auto reference_index = static_cast<uint64_t>(start.reference);
   const auto init_index = static_cast<uint64_t>(start.start);
-  frames_[init_index].pose.T_w_b = start.T_w_start;
-  frames_[init_index].pose.valid = true;
+  // Every frame from the reference to the start gets a pose in the unit the map started in.
+  const auto posed = [&](uint64_t i, const SE3& T_w_b) {
+    FrameRecord& r = frames_[i];
+    r.pose.T_w_b = T_w_b;
+    r.pose.valid = true;
+    r.pose.metric = start.metric;
+    r.pose.roughly_metric = start.roughly_metric;
+    r.unknown_scale = !start.metric;
+  };
+  posed(init_index, start.T_w_start);
   frames_[init_index].map_start = true;
-  frames_[init_index].unknown_scale = frames_[seen_index].unknown_scale;
-  frames_[init_index].pose.roughly_metric = frames_[seen_index].pose.roughly_metric;
   const SE3 a = start.T_w_reference;
   const SE3 b = start.T_w_start;
-  frames_[reference_index].pose.T_w_b = a;
-  frames_[reference_index].pose.valid = true;
-  frames_[reference_index].unknown_scale = frames_[init_index].unknown_scale;
-  frames_[reference_index].pose.roughly_metric = frames_[init_index].pose.roughly_metric;
+  posed(reference_index, a);
   const Vec6 xi = (a.inverse() * b).log();
   for (uint64_t i = reference_index + 1; i < init_index; ++i) {
     const double s = static_cast<double>(i - reference_index) / static_cast<double>(init_index - reference_index);
-    frames_[i].pose.T_w_b = a * SE3::exp(s * xi);
-    frames_[i].pose.valid = true;
+    posed(i, a * SE3::exp(s * xi));
     frames_[i].interpolated = true;
-    frames_[i].unknown_scale = frames_[init_index].unknown_scale;
-    frames_[i].pose.roughly_metric = frames_[init_index].pose.roughly_metric;
   }
 }
 

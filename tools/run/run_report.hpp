@@ -16,7 +16,8 @@ struct FrameRecord {
   PipelineTiming timing;
   bool interpolated = false;   // filled in after a two-frame initialization
   bool map_start = false;      // a two-frame map started here, published as not initialized, its pose filled in
-  bool unknown_scale = false;  // its position is not in metres (one camera; a rig without overlap before its scale)
+  bool unknown_scale = false;  // its position is not in metres (one camera; a rig without overlap before its scale;
+                               // a roughly metric map: pose.roughly_metric)
 };
 
 // A frame whose tracking state differs from the frame before (the first frame counts as one).

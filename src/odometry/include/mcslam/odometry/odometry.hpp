@@ -34,8 +34,9 @@ struct OdometryStats {
   uint64_t extrinsic_reestimations = 0;  // cameras whose extrinsic the per-camera check replaced
   uint64_t stamps_not_increasing = 0;    // frames stamped at or before the frame before them (LossClock)
   double last_backend_ms = 0;
-  // Metric scale of a rig without overlap (started up to scale): frame from which the map is metric (-1: not
-  // yet, or the map started metric), the window's scale estimates and the rescalings they caused.
+  // Metric scale of a rig without overlap (started up to scale), or of a roughly metric map: frame from which the
+  // map is metric (-1: not yet, or the map started metric), the window's scale estimates and the rescalings they
+  // caused.
   int64_t scale_converged_frame = -1;
   uint64_t scale_estimates = 0;
   uint64_t scale_rescales = 0;
@@ -74,10 +75,10 @@ class Odometry {
   // process() does it first thing; call it after the last frame, before reading the map's final keyframes.
   void flush();
   // A keyframe of a map that applies each solve before the next frame (one camera's maps, maps started up to
-  // scale, and any map when backend_apply_after_frames is 1) leaves its new landmarks to the back-end thread,
-  // before its solve: the next frame tracks on the same map as if they had been made at once, and the keyframe's
-  // frame no longer pays for them. The job writes the map, so it starts only once the frame has no more use for
-  // the new landmarks: the caller says when (the pipeline, after place memory); flush() and the next process()
+  // scale or roughly metric, and any map when backend_apply_after_frames is 1) leaves its new landmarks to the back-end
+  // thread, before its solve: the next frame tracks on the same map as if they had been made at once, and the
+  // keyframe's frame no longer pays for them. The job writes the map, so it starts only once the frame has no more use
+  // for the new landmarks: the caller says when (the pipeline, after place memory); flush() and the next process()
   // start it otherwise. From then until the next process() or flush(), map() may be read only for what the job
   // does not write: keyframes' poses, stamps and ids.
   void startDeferredMapping();
@@ -115,10 +116,11 @@ class Odometry {
   const Rig& trackingRig() const { return rigState().rig(); }
   bool initialized() const { return initialized_; }
   // False while a map started up to scale (rig without overlap) waits for its window to fix the scale: poses
-  // until then have an arbitrary unit. True for a metric start and for one camera (whose scale never is).
+  // until then have an arbitrary unit. True for a metric start, a roughly metric one (no estimate runs for it) and
+  // for one camera (whose scale never is).
   bool scaleConverged() const { return rigState().scaleConverged(); }
-  // Relative standard deviation of the map's unit now (ScaleSupervisor::unitSigma): how far the length of a motion
-  // tracked in this map can be off while its direction is not.
+  // Relative standard deviation of the map's unit now (ScaleSupervisor::unitSigma; a fixed 25% for a roughly
+  // metric map): how far the length of a motion tracked in this map can be off while its direction is not.
   double unitSigma() const;
   // Heap allocations made so far on the back-end thread and the scale estimate's (0 when they run inline).
   uint64_t backendThreadAllocations() const;
@@ -131,6 +133,8 @@ class Odometry {
     int64_t start = -1;
     SE3 T_w_reference;
     SE3 T_w_start;
+    bool metric = true;  // the unit of both poses as the map started (PoseEstimate's flags)
+    bool roughly_metric = false;
   };
   const InitializationSpan& lastInitialization() const { return last_init_; }
 
@@ -151,7 +155,8 @@ class Odometry {
   void unitBecomesMetric(const FrameFeatures& frame, uint64_t frame_index);
   // The map starts at keyframe `kf_new` of frame `frame_index`: the track state.
   void startMap(int kf_new, uint64_t frame_index, ScaleStatus scale, bool new_map = true);
-  void publishStart(PoseEstimate& out);  // the frame the map started at is its first keyframe, tracked
+  void publishStart(PoseEstimate& out);       // the frame the map started at is its first keyframe, tracked
+  void publishUnit(PoseEstimate& out) const;  // the pose's unit flags, from the rig state as it is now
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
   // The frame could not be tracked: the motion model carries on; a loss that lasts drops the map.
   void lose(uint64_t frame_index, int inliers, PoseEstimate& out);

@@ -35,8 +35,8 @@ struct OdometryOptions {
 
   // Keyframes.
   // New keyframe when a frame's tracking inliers fall below this share of the most a frame had since the last
-  // one (of all the last keyframe's landmarks in a map whose unit rests on its window: one camera, or a start up
-  // to scale).
+  // one (of all the last keyframe's landmarks in a map whose unit rests on its window: one camera, a start up
+  // to scale or roughly metric).
   double keyframe_tracked_ratio = 0.75;
   int keyframe_max_interval = 8;  // frames: at least one keyframe per this many, while the rig moves (below)
   double keyframe_rotation_deg = 8.0;

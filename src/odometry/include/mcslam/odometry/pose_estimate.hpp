@@ -33,8 +33,8 @@ struct PoseEstimate {
   float quality = 0;  // 0..1: inliers over the landmark observations the map predicted in the images
   bool is_keyframe = false;
   bool valid = false;  // T_w_b holds an estimate
-  // T_w_b.t is in metres. False when its unit is arbitrary: one camera, or a rig without overlap whose map
-  // started up to scale and has not yet found it.
+  // T_w_b.t is in metres. False when its unit is arbitrary (one camera, or a rig without overlap whose map
+  // started up to scale and has not yet found it) or only roughly the metre (below).
   bool metric = true;
   // With `metric` false: the unit is the metre as overlapping cameras measured it from points too far for their
   // baseline (a few centimetres apart, a far scene; ScaleStatus::Uncertain): lengths can be tens of percent off.

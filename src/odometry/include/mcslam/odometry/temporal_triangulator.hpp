@@ -20,8 +20,8 @@ class TemporalTriangulator {
  public:
   TemporalTriangulator(const Rig& rig, const OdometryOptions& options, int max_features_per_camera);
 
-  // Whether the map's unit rests on these points (one camera, a rig without overlap): then they are accepted on
-  // an unbiased rule (see the .cpp).
+  // Whether the map's unit rests on these points (one camera, a rig without overlap, a roughly metric map): then they
+  // are accepted on an unbiased rule (see the .cpp).
   void setSceneReferencedPoints(bool on) { scene_referenced_points_ = on; }
 
   // New landmarks from keyframe `slot`'s unmatched keypoints and those of the previous keyframes, with the

@@ -48,8 +48,8 @@ class Tracker {
   // The landmarks matched in this frame become the first attempt's list for the next one.
   void rememberTracked(const Map& map, const FrameFeatures& frame, uint64_t frame_index);
   // A new map starts at its keyframe `slot` (of frame `frame_index`): tracking continues from its pose and
-  // landmarks, without velocity. `unit_on_window`: the map's unit rests on the back-end window (one camera, or a
-  // start up to scale), which sets the keyframe rule (needKeyframe).
+  // landmarks, without velocity. `unit_on_window`: the map's unit rests on the back-end window (one camera, a
+  // start up to scale or roughly metric), which sets the keyframe rule (needKeyframe).
   void startFrom(const Map& map, int slot, uint64_t frame_index, bool unit_on_window);
   // The map's uncertain unit became metric: keyframes from now on as in a map that started metric.
   void unitLeavesWindow() { unit_on_window_ = false; }

@@ -59,7 +59,7 @@ class WindowBridge {
   void rescale(Map& map, double s, const Vec3& center);
   // Whether the window holds its scale (OdometryOptions::hold_window_scale, else its two oldest keyframes fixed)
   // instead of letting its reprojections pull it: for a map whose unit only explicit rescales may change (a rig
-  // without overlap). No solve may be in flight; reset() lets it go.
+  // without overlap, a roughly metric map). No solve may be in flight; reset() and holdScale(false) let it go.
   void holdScale(bool hold);
   // A fresh window for a new map (allocates: only after tracking was lost, never per frame).
   void reset();
