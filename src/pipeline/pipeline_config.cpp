@@ -58,6 +58,7 @@ void readMultiView(ConfigSection s, PipelineConfig& c) {
   s.read("align_subpixel", c.multiview.align_subpixel);
   s.read("align_recentre", c.multiview.recentre_reference);
   s.read("unique_two_view", c.multiview.unique_two_view);
+  s.read("two_view_visibility_check", c.multiview.two_view_visibility_check);
   s.read("landmark_depth_sigma", c.odometry.landmark_max_depth_sigma, 1e-4, 1.0);
   s.finish();
   if (c.overlap.max_depth <= c.overlap.min_depth) s.fail("max_depth", "must be larger than min_depth");
@@ -215,6 +216,7 @@ std::string formatPipelineConfig(const PipelineConfig& c) {
      << "    align_subpixel: " << (c.multiview.align_subpixel ? "true" : "false") << "\n"
      << "    align_recentre: " << (c.multiview.recentre_reference ? "true" : "false") << "\n"
      << "    unique_two_view: " << (c.multiview.unique_two_view ? "true" : "false") << "\n"
+     << "    two_view_visibility_check: " << (c.multiview.two_view_visibility_check ? "true" : "false") << "\n"
      << "    landmark_depth_sigma: " << o.landmark_max_depth_sigma << "\n"
      << "  tracking:\n"
      << "    max_hamming: " << o.max_hamming << "\n"
