@@ -273,7 +273,7 @@ std::unique_ptr<test::TempDir> RunAfterALoss::dir_;
 
 // After a loss that lasts, one camera starts a new map from two frames; the frames from its reference to its start
 // had no pose of their own and are written afterwards, from the new map's keyframes, where the rig was: the
-// trajectory has no jump there (they were written at the origin when the reference's keyframe pose was not used).
+// trajectory has no jump there (the reference's keyframe pose places them, not the origin).
 TEST_F(RunAfterALoss, ANewMapFromTwoFramesWritesItsFirstFramesWhereTheRigWas) {
   const std::string stats = run("new_map", "--black 40-50 --config " + dir_->file("no_places.yaml"));
   ASSERT_EQ(jsonInt(stats, "map_starts_posed_afterwards"), 2) << stats;  // the first map, and the one after the loss

@@ -1,10 +1,10 @@
 #pragma once
-// A two-frame initialization attempt (Initializer::feed) taken off the frame's thread. Its matching and
-// relative-pose RANSAC cost a frame of one camera more than tracking it does, and a rig that starts from two
-// frames makes one attempt per frame until it succeeds: on the frame's thread they are its slowest frames. The
-// attempt of frame k runs beside the next frame's front-end and is taken at frame k + 1 (waiting for it if it is not
-// done), so what follows never depends on the thread's timing: a map that starts from it starts at frame k, seen
-// from frame k + 1, which is then tracked on it. Without a thread the attempt runs at once, with the same result.
+// A two-frame initialization attempt (Initializer::feed) taken off the frame's thread: its matching and
+// relative-pose RANSAC cost more than tracking a frame, and a rig that starts from two frames makes one per frame
+// until it succeeds. The attempt of frame k runs beside the next frame's front-end and is taken at frame k + 1 (waiting
+// for it if it is not done), so what follows never depends on the thread's timing: a map that starts from it starts at
+// frame k, seen from frame k + 1, which is then tracked on it. Without a thread the attempt runs at once, with the same
+// result.
 #include <cstdint>
 #include <memory>
 #include <thread>

@@ -35,7 +35,7 @@ class RigState {
   // Poses in metres (the flag PoseEstimate::metric carries).
   bool metric() const { return scale_ == ScaleStatus::Metric; }
   // False while a map started up to scale waits for its unit; true otherwise (one camera never waits, nor an
-  // uncertain unit: its window estimates would re-measure the same far points).
+  // uncertain unit: a window estimate would fit the same far points that gave it).
   bool scaleConverged() const { return scale_ != ScaleStatus::Unscaled; }
   uint64_t version() const { return version_; }
 
