@@ -19,10 +19,17 @@ Initializer::Initializer(const Rig& rig, const OdometryOptions& options, int max
   candidate_of_cur_.resize(max_features_per_camera);
 }
 
+namespace {
+
+bool usable(const MultiViewFeature& mv, double max_depth_sigma) {
+  return mv.has_point && mv.relative_depth_sigma <= max_depth_sigma;
+}
+
+}  // namespace
+
 int Initializer::usableMultiView(const FrameFeatures& f, double max_depth_sigma) {
   int n = 0;
-  for (int t = 0; t < f.mv_count; ++t)
-    n += f.mv[t].has_point && f.mv[t].relative_depth_sigma <= max_depth_sigma ? 1 : 0;
+  for (int t = 0; t < f.mv_count; ++t) n += usable(f.mv[t], max_depth_sigma) ? 1 : 0;
   return n;
 }
 
@@ -45,12 +52,8 @@ double Initializer::multiViewDisparityPx(const FrameFeatures& f, int t, const Ri
 int Initializer::metricMultiView(const FrameFeatures& f, const Rig& rig, double max_depth_sigma,
                                  double min_disparity_px) {
   int n = 0;
-  for (int t = 0; t < f.mv_count; ++t) {
-    const MultiViewFeature& mv = f.mv[t];
-    if (mv.has_point && mv.relative_depth_sigma <= max_depth_sigma &&
-        multiViewDisparityPx(f, t, rig) >= min_disparity_px)
-      ++n;
-  }
+  for (int t = 0; t < f.mv_count; ++t)
+    n += usable(f.mv[t], max_depth_sigma) && multiViewDisparityPx(f, t, rig) >= min_disparity_px ? 1 : 0;
   return n;
 }
 

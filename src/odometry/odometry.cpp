@@ -220,8 +220,7 @@ void Odometry::unitBecomesMetric(const FrameFeatures& frame, uint64_t frame_inde
   // metric points this keyframe brings pull it to the metre as a metric start's do.
   bridge_->setScaleStatus(ScaleStatus::Metric);
   bridge_->holdScale(false);
-  triangulator_->setSceneReferencedPoints(false);
-  apply_after_frames_ = options_.backend_apply_after_frames;
+  restUnitOnWindow(false);
   tracker_->unitLeavesWindow();
   stats_.scale_converged_frame = static_cast<int64_t>(frame_index);
   spdlog::info(
@@ -411,10 +410,7 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, ScaleStatus scale, boo
   // scale random-walk wherever nothing constrains it (no turn; cross-camera points at a pixel of disparity).
   // resetMap() lets it go.
   if (scale == ScaleStatus::Unscaled || scale == ScaleStatus::Uncertain) bridge_->holdScale(true);
-  triangulator_->setSceneReferencedPoints(unit_on_window);
-  // A map whose unit rests on its window (one camera, no overlap before the scale is found, roughly metric) tracks
-  // on solved maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
-  apply_after_frames_ = unit_on_window ? 1 : options_.backend_apply_after_frames;
+  restUnitOnWindow(unit_on_window);
   scale_->start(scale == ScaleStatus::Unscaled);
   if (new_map) ++stats_.initializations;  // a relocalization continues the map it found
   ++stats_.keyframes;
@@ -422,6 +418,13 @@ void Odometry::startMap(int kf_new, uint64_t frame_index, ScaleStatus scale, boo
   lost_frames_ = 0;
   for (int k = 0; k < map_.keyframeCapacity(); ++k)
     if (map_.keyframe(k).alive) noteSettled(k);  // the keyframes of the start are final: solved once
+}
+
+void Odometry::restUnitOnWindow(bool on_window) {
+  triangulator_->setSceneReferencedPoints(on_window);
+  // A map whose unit rests on its window (one camera, no overlap before the scale is found, roughly metric) tracks
+  // on solved maps only: a frame tracked on the map before its solve keeps the unit that solve corrects.
+  apply_after_frames_ = on_window ? 1 : options_.backend_apply_after_frames;
 }
 
 void Odometry::publishStart(PoseEstimate& out) {

@@ -13,7 +13,6 @@ namespace mcslam::run {
 
 bool RunReport::add(const PoseEstimate& pose, const PipelineTiming& timing) {
   FrameRecord r;
-  r.unknown_scale = pose.valid && !pose.metric;
   r.t = pose.t;
   r.pose = pose;
   r.timing = timing;
@@ -40,7 +39,6 @@ void RunReport::backfill(const Odometry::InitializationSpan& start, uint64_t see
     r.pose.valid = true;
     r.pose.metric = start.metric;
     r.pose.roughly_metric = start.roughly_metric;
-    r.unknown_scale = !start.metric;
   };
   posed(init_index, start.T_w_start);
   frames_[init_index].map_start = true;
@@ -126,8 +124,8 @@ void RunReport::writeStats(const std::string& path, const SlamPipeline& pipeline
     ++state_count[static_cast<int>(r.pose.state)];
     interpolated += r.interpolated ? 1 : 0;
     map_starts += r.map_start ? 1 : 0;
-    unknown_scale += r.unknown_scale ? 1 : 0;
-    roughly_metric += r.unknown_scale && r.pose.roughly_metric ? 1 : 0;
+    unknown_scale += r.unknownScale() ? 1 : 0;
+    roughly_metric += r.unknownScale() && r.pose.roughly_metric ? 1 : 0;
     unanchored += r.pose.unanchored ? 1 : 0;
   }
   const OdometryStats& s = pipeline.stats();

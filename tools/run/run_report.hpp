@@ -14,10 +14,11 @@ struct FrameRecord {
   Timestamp t = 0;
   PoseEstimate pose;
   PipelineTiming timing;
-  bool interpolated = false;   // filled in after a two-frame initialization
-  bool map_start = false;      // a two-frame map started here, published as not initialized, its pose filled in
-  bool unknown_scale = false;  // its position is not in metres (one camera; a rig without overlap before its scale;
-                               // a roughly metric map: pose.roughly_metric)
+  bool interpolated = false;  // filled in after a two-frame initialization
+  bool map_start = false;     // a two-frame map started here, published as not initialized, its pose filled in
+  // Its position is not in metres (one camera; a rig without overlap before its scale; a roughly metric map:
+  // pose.roughly_metric).
+  bool unknownScale() const { return pose.valid && !pose.metric; }
 };
 
 // A frame whose tracking state differs from the frame before (the first frame counts as one).

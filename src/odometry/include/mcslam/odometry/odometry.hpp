@@ -155,6 +155,8 @@ class Odometry {
   void unitBecomesMetric(const FrameFeatures& frame, uint64_t frame_index);
   // The map starts at keyframe `kf_new` of frame `frame_index`: the track state.
   void startMap(int kf_new, uint64_t frame_index, ScaleStatus scale, bool new_map = true);
+  // New points across time and when solves are applied, for a map whose unit rests on its window or not.
+  void restUnitOnWindow(bool on_window);
   void publishStart(PoseEstimate& out);       // the frame the map started at is its first keyframe, tracked
   void publishUnit(PoseEstimate& out) const;  // the pose's unit flags, from the rig state as it is now
   void processFrame(const FrameFeatures& frame, uint64_t frame_index, PoseEstimate& out);
