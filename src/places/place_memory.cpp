@@ -142,7 +142,7 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   }
   map_.setUnitSigma(slot, odometry.unitSigma());
   std::fill(own_points_.begin(), own_points_.end(), Eigen::Vector3f::Constant(std::nanf("")));
-  gatherPoints(local, kf, slot, own_points_);
+  gatherPoints(local, odometry.trackingRig(), kf, slot, own_points_);
   // One camera's window lets its unit drift from one keyframe to the next: its points stay as they were made.
   // (Each entry names a live keyframe of the odometry's pool, which has room for them all.)
   if (cameras_.size() > 1 && odometry.unitSigma() >= kUncertainUnit && kf.in_backend &&
@@ -163,7 +163,21 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   }
 }
 
-void PlaceMemory::gatherPoints(const Map& local, const Keyframe& kf, int slot, std::span<Eigen::Vector3f> own) {
+namespace {
+
+// The point of the keyframe's ray closest to `p_b` (body frame, world unit; the lever arm is metric): a place is
+// what its keyframe saw, so from the keyframe's own pose its points project onto its keypoints whatever depths the
+// window's solve gave them. A window that fitted the start's motion in a unit not yet known leaves pixels of
+// residual there, and a loop back to the place would fit a sideways shift to them: the solve gives the depth only.
+Vec3 ontoObservedRay(const Vec3& p_b, const SE3& T_b_c, const Vec3& bearing_c) {
+  const double depth = (T_b_c.inverse() * p_b).dot(bearing_c);
+  return depth > 0 ? Vec3(T_b_c * (depth * bearing_c)) : p_b;
+}
+
+}  // namespace
+
+void PlaceMemory::gatherPoints(const Map& local, const Rig& rig, const Keyframe& kf, int slot,
+                               std::span<Eigen::Vector3f> own) {
   const SE3 T_k_o = kf.T_w_b.inverse();
   const double unit = map_.keyframe(slot).unit;  // the place map's points are in the world's unit
   const int levels_up = words_.directLevelsUp();
@@ -182,7 +196,10 @@ void PlaceMemory::gatherPoints(const Map& local, const Keyframe& kf, int slot, s
       // keyframe made in this frame, seen from it and one earlier keyframe, may not exist yet.)
       if (!l.metric && local.observingKeyframes(lm) < 3) continue;
       PlacePoint p;
-      p.p_k = (unit * (T_k_o * l.p_w)).cast<float>();
+      const Vec3 p_b = unit * (T_k_o * l.p_w);
+      const bool seen = kf.features.valid[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)];
+      const Vec3& bearing = kf.features.bearings[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)];
+      p.p_k = (seen ? ontoObservedRay(p_b, rig.T_b_c(c), bearing) : p_b).cast<float>();
       if (!own.empty()) own[static_cast<std::size_t>(c * features_per_camera_ + k)] = p.p_k;
       p.descriptor = l.descriptor;
       p.node = vocabulary_.ancestor(vocabulary_.word(l.descriptor), levels_up);
@@ -213,7 +230,7 @@ void PlaceMemory::refinePlaces(const Odometry& odometry) {
     collectLoopDetection(/*wait=*/true);  // it reads the points
     map_.refinePose(u.place_slot, kf.T_w_b);
     map_.clearPoints(u.place_slot);
-    gatherPoints(local, kf, u.place_slot, {});
+    gatherPoints(local, odometry.trackingRig(), kf, u.place_slot, {});
     ++stats_.places_refined;
   }
   unrefined_count_ = waiting;

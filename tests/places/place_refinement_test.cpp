@@ -4,6 +4,8 @@
 // taking them allocates nothing. Exact synthetic geometry (the odometry's own test sequence), no rendering.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "../odometry/synthetic_sequence.hpp"
@@ -97,6 +99,57 @@ TEST(PlaceRefinement, PlacesOfAnUncertainUnitTakeTheWindowsPointsWhenTheirKeyfra
   if (test::countsAllocations()) {
     EXPECT_EQ(allocations, 0u);
   }
+}
+
+// A place holds what its keyframe saw: from the keyframe's own pose each of its points lies on the ray of one of
+// its camera's keypoints, whatever depth the window's solve gave it. (The keypoints carry 0.5 px of noise, so the
+// solved points lie off their rays by about that much: a loop from where the keyframe was would measure that.)
+TEST(PlaceRefinement, APlacesPointsLieOnItsKeyframesRays) {
+  const Rig rig = test::nonOverlappingRig3();
+  test::SyntheticSequenceOptions so;
+  so.frames = 60;
+  test::SyntheticSequence seq(rig, so);
+  OverlapMap overlap(rig, OverlapOptions{});
+  MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
+  const OdometryOptions odometry_options;
+  Odometry odometry(rig, odometry_options, so.max_features);
+  static const Vocabulary vocabulary = loadVocabulary("");
+  PlacesOptions places;
+  places.repeatable = true;
+  PlaceMemory memory(rig, vocabulary, places, odometry_options, so.max_features);
+  FrameFeatures frame(rig.size(), so.max_features);
+  for (int i = 0; i < seq.frames(); ++i) {
+    seq.fill(i, frame);
+    matcher.compute(frame);
+    PoseEstimate pose;
+    odometry.process(frame, static_cast<uint64_t>(i), pose);
+    memory.afterOdometry(frame, static_cast<uint64_t>(i), odometry, pose);
+    odometry.startDeferredMapping();
+  }
+  const Map& local = odometry.map();
+  int checked = 0;
+  double worst_rad = 0;
+  for (int slot = 0; slot < memory.map().capacity(); ++slot) {
+    const PlaceKeyframe& place = memory.map().keyframe(slot);
+    for (int k = 0; place.alive && k < local.keyframeCapacity(); ++k) {
+      const Keyframe& kf = local.keyframe(k);
+      if (!kf.alive || kf.frame_index != place.frame_index) continue;
+      for (const PlacePoint& p : memory.map().points(slot)) {
+        const Vec3 ray = (rig.T_b_c(p.cam).inverse() * p.p_k.cast<double>()).normalized();
+        double nearest = M_PI;
+        const auto cam = static_cast<std::size_t>(p.cam);
+        for (int f = 0; f < kf.features.sets[cam].count; ++f)
+          if (kf.features.valid[cam][static_cast<std::size_t>(f)])
+            nearest = std::min(
+                nearest,
+                std::acos(std::clamp(ray.dot(kf.features.bearings[cam][static_cast<std::size_t>(f)]), -1.0, 1.0)));
+        worst_rad = std::max(worst_rad, nearest);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 500);
+  EXPECT_LT(worst_rad, 1e-5) << "a place's point lies " << worst_rad << " rad off its keyframe's rays";
 }
 
 }  // namespace

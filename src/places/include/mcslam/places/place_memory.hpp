@@ -94,7 +94,7 @@ class PlaceMemory {
   void addKeyframe(const Odometry& odometry, int odometry_slot);
   // Place keyframe `slot`'s points: those of odometry keyframe `kf` whose position is certain, in its body frame.
   // `own` (empty, or cam * max features + kp): each keypoint's point, for a loop's scale.
-  void gatherPoints(const Map& local, const Keyframe& kf, int slot, std::span<Eigen::Vector3f> own);
+  void gatherPoints(const Map& local, const Rig& rig, const Keyframe& kf, int slot, std::span<Eigen::Vector3f> own);
   // The places waiting for their keyframe to leave the odometry's window take its points and pose then.
   void refinePlaces(const Odometry& odometry);
   bool refinementDue(const Odometry& odometry) const;  // a waiting place's keyframe has left the window
