@@ -207,6 +207,20 @@ bool LoopCloser::takeCorrection(PlaceMap& map, bool wait) {
   return true;
 }
 
+void LoopCloser::followRescale(const PlaceMap& map, int32_t segment, double s, uint64_t from_frame) {
+  if (similarity()) return;
+  const auto rescaled = [&](int64_t id) {
+    const int slot = map.slotOfId(id);
+    return slot >= 0 && map.keyframe(slot).segment == segment && map.keyframe(slot).frame_index >= from_frame;
+  };
+  for (int i = 0; i < loop_count_; ++i) {
+    LoopEdge& e = loops_[static_cast<std::size_t>(i)];
+    if (!rescaled(e.a) || !rescaled(e.b)) continue;
+    e.T_a_b.t *= s;
+    e.sigma.head<3>() *= s;
+  }
+}
+
 void LoopCloser::startCorrection(const PlaceMap& map) {
   const int segments = map.segments();
   for (int32_t s = 0; s < segments; ++s) roots_[static_cast<std::size_t>(s)] = findRoot(s);

@@ -177,6 +177,13 @@ SE3 PlaceMap::segmentPoseFor(int32_t segment, const SE3& T_w_b, const SE3& T_o_b
   return (Sim3(T_w_b, segmentScale(segment)) * Sim3(T_o_b).inverse()).rigid();
 }
 
+int PlaceMap::slotOfId(int64_t id) const {
+  for (int slot = 0; slot < capacity(); ++slot)
+    if (keyframes_[static_cast<std::size_t>(slot)].alive && keyframes_[static_cast<std::size_t>(slot)].id == id)
+      return slot;
+  return -1;
+}
+
 void PlaceMap::rescaleSegment(int32_t segment, double s, const Vec3& center, uint64_t from_frame,
                               std::span<const Vec3> camera_centers) {
   ++reshapes_;

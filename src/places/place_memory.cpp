@@ -47,8 +47,10 @@ void PlaceMemory::afterOdometry(const FrameFeatures& frame, uint64_t frame_index
   // Before the keyframes settled in this frame join: they are in the new unit already.
   // The lever arms the odometry rescaled its landmarks with.
   if (!odometry.rescales().empty()) odometry.trackingRig().cameraCenters(camera_centers_);
-  for (const Odometry::Rescale& r : odometry.rescales())
+  for (const Odometry::Rescale& r : odometry.rescales()) {
     map_.rescaleSegment(segment_, r.s, r.center, r.from_frame, camera_centers_);
+    loop_closer_.followRescale(map_, segment_, r.s, r.from_frame);
+  }
   if (!localize_only_) {
     refinePlaces(odometry);  // before a loop of this frame's keyframes starts a correction from their poses
     for (const int32_t slot : odometry.settledKeyframes()) addKeyframe(odometry, slot);
@@ -151,11 +153,15 @@ void PlaceMemory::addKeyframe(const Odometry& odometry, int odometry_slot) {
   words_.compute(vocabulary_, kf.features);
   database_.insert(slot, words_.bow());
   ++stats_.keyframes;
-  // SE(3) closures need a metric map (or one whose uncertain unit its window holds), Sim(3) ones (one camera) a
-  // unit that stays put between loops: a map of a rig without overlap whose unit is still being found waits for it.
+  // SE(3) closures need a unit that holds between loops: a metric map, one whose uncertain unit its window holds, or
+  // a rig without overlap whose unit the scale estimate knows to kUncertainUnit (the graph lets the odometry's
+  // lengths give way by it, and the loops take the rescales that follow); Sim(3) ones (one camera) a unit that stays
+  // put between loops.
   const ScaleStatus scale = odometry.rigState().scale();
-  const bool closable = loop_closer_.similarity() ? scale == ScaleStatus::Monocular
-                                                  : scale == ScaleStatus::Metric || scale == ScaleStatus::Uncertain;
+  const bool closable = loop_closer_.similarity()
+                            ? scale == ScaleStatus::Monocular
+                            : scale == ScaleStatus::Metric || scale == ScaleStatus::Uncertain ||
+                                  (scale == ScaleStatus::Unscaled && odometry.unitSigma() < kUncertainUnit);
   if (options_.loop_closure && closable) {
     loop_closer_.setRig(odometry.trackingRig());
     loop_closer_.startDetection(slot, kf.features, words_, map_, database_, own_points_);

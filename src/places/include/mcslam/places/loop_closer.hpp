@@ -81,6 +81,10 @@ class LoopCloser {
   const LoopStats& stats() const { return stats_; }
   int loops() const { return loop_count_; }
   std::span<const LoopEdge> loopEdges() const { return {loops_.data(), static_cast<std::size_t>(loop_count_)}; }
+  // `map` rescaled the keyframes of `segment` made from `from_frame` on by `s` (PlaceMap::rescaleSegment): a loop
+  // between two of them was measured in the unit they had, and takes theirs. (Sim(3) loops are kept in their
+  // keyframes' units already.)
+  void followRescale(const PlaceMap& map, int32_t segment, double s, uint64_t from_frame);
   void clear();  // waits for a detection in flight and drops it
   // The segment that stands for all those loops have joined to `segment`.
   int32_t root(int32_t segment) { return findRoot(segment); }

@@ -78,6 +78,7 @@ class PlaceMap {
   int createKeyframe(int32_t segment, Timestamp t, uint64_t frame_index, const SE3& T_w_k, const SE3& T_o_k);
   void setUnitSigma(int slot, double sigma) { keyframes_[static_cast<std::size_t>(slot)].unit_sigma = sigma; }
   bool addPoint(int slot, const PlacePoint& point);  // false when the keyframe holds its maximum
+  int slotOfId(int64_t id) const;                    // the live keyframe's, or -1 (a scan of the pool)
   void finishKeyframe(int slot);
   void eraseKeyframe(int slot);  // its neighbours become each other's
   // The keyframe a full map can best do without (slot, -1 when none may go): the one whose neighbours in its
