@@ -208,7 +208,7 @@ bool LoopCloser::takeCorrection(PlaceMap& map, bool wait) {
 }
 
 void LoopCloser::followRescale(const PlaceMap& map, int32_t segment, double s, uint64_t from_frame) {
-  if (similarity()) return;
+  if (similarity() || loop_count_ == 0) return;
   const auto rescaled = [&](int64_t id) {
     const int slot = map.slotOfId(id);
     return slot >= 0 && map.keyframe(slot).segment == segment && map.keyframe(slot).frame_index >= from_frame;

@@ -5,7 +5,7 @@
 // Sim(3) correction takes the drift of the unit out too: keyframes, their points and the segment's odometry unit.
 // In a metric map whose unit was uncertain for a stretch (a rig without overlap before its scale converged), the
 // rigid correction stretches that stretch instead of bending the rest. Rotations stay orthonormal over many
-// corrections. A loop within a stretch the odometry rescaled takes the stretch's new unit.
+// corrections. A loop within a segment the odometry rescaled takes the segment's new unit.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -322,32 +322,35 @@ TEST(LoopCorrection, RotationsStayOrthonormalOverManyCorrections) {
   EXPECT_LT(worst, 1e-12);
 }
 
-// A rig without overlap rescales the keyframes of its segment from some frame on while it finds its unit: a loop
-// between two of them was measured in the unit they had and takes the new one; a loop onto a keyframe before the
-// stretch is between two units and stays as measured.
-TEST(LoopCorrection, ALoopWithinARescaledStretchTakesItsUnit) {
+// Before its unit converged, a rig without overlap rescales the whole of its segment when the estimate moves: a
+// loop within the segment was measured in the unit the keyframes had and takes the new one; a loop onto another
+// segment's keyframe spans two units and stays as measured.
+TEST(LoopCorrection, ALoopWithinARescaledSegmentTakesItsUnit) {
   DriftedLoop d = driftedLoop(40);
-  const LoopEdge within{d.map.keyframe(20).id, d.map.keyframe(39).id,
-                        d.map.keyframe(20).T_w_k.inverse() * d.map.keyframe(39).T_w_k, Vec6::Constant(0.01)};
-  const LoopEdge loops[] = {d.loop, within};
+  const int32_t other = d.map.createSegment(SE3());
+  const int slot = d.map.createKeyframe(other, 100, 100, d.truth[5], d.truth[5]);
+  const LoopEdge across{d.map.keyframe(slot).id, d.map.keyframe(39).id,
+                        d.map.keyframe(slot).T_w_k.inverse() * d.map.keyframe(39).T_w_k, Vec6::Constant(0.01)};
+  const LoopEdge loops[] = {d.loop, across};
   std::string bytes;
   ByteWriter out(bytes);
-  putLoops(out, loops, {kOwnRoots.data(), 1});
+  putLoops(out, loops, {kOwnRoots.data(), 2});
   const Rig rig = test::nonOverlappingRig3();
   LoopCloser closer(rig, PlacesOptions{}, 1.2f, 64, /*similarity=*/false);
   ByteReader in(bytes, "loops");
-  closer.read(in, 1);
+  closer.read(in, 2);
   const std::vector<Vec3> centers = rig.cameraCenters();
-  d.map.rescaleSegment(d.segment, 2.0, Vec3::Zero(), /*from_frame=*/10, centers);
-  closer.followRescale(d.map, d.segment, 2.0, /*from_frame=*/10);
+  const SE3 before = d.map.keyframe(0).T_w_k.inverse() * d.map.keyframe(39).T_w_k;
+  d.map.rescaleSegment(d.segment, 2.0, Vec3::Zero(), /*from_frame=*/0, centers);
+  closer.followRescale(d.map, d.segment, 2.0, /*from_frame=*/0);
   ASSERT_EQ(closer.loopEdges().size(), 2u);
-  EXPECT_LT((closer.loopEdges()[0].T_a_b.t - d.loop.T_a_b.t).norm(), 1e-12);
-  EXPECT_LT((closer.loopEdges()[1].T_a_b.t - 2.0 * within.T_a_b.t).norm(), 1e-12);
-  EXPECT_DOUBLE_EQ(closer.loopEdges()[1].sigma[0], 0.02);
-  EXPECT_DOUBLE_EQ(closer.loopEdges()[1].sigma[3], 0.01);  // rotations have no unit
-  // The map moved the stretch alike: the loop within it agrees with its keyframes again.
-  const SE3 now = d.map.keyframe(20).T_w_k.inverse() * d.map.keyframe(39).T_w_k;
-  EXPECT_LT((closer.loopEdges()[1].T_a_b.t - now.t).norm(), 1e-9);
+  EXPECT_LT((closer.loopEdges()[0].T_a_b.t - 2.0 * d.loop.T_a_b.t).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(closer.loopEdges()[0].sigma[0], 0.02);
+  EXPECT_DOUBLE_EQ(closer.loopEdges()[0].sigma[3], 0.01);  // rotations have no unit
+  EXPECT_LT((closer.loopEdges()[1].T_a_b.t - across.T_a_b.t).norm(), 1e-12);
+  // The map stretched the segment alike: the loop and its keyframes are in one unit again.
+  const SE3 now = d.map.keyframe(0).T_w_k.inverse() * d.map.keyframe(39).T_w_k;
+  EXPECT_NEAR(now.t.norm() / before.t.norm(), closer.loopEdges()[0].T_a_b.t.norm() / d.loop.T_a_b.t.norm(), 1e-9);
 }
 
 }  // namespace

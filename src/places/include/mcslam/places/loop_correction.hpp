@@ -20,8 +20,9 @@ namespace mcslam {
 
 // A loop: keyframe b seen from keyframe a, with the uncertainty of the verification. In a map whose unit is not
 // metric (a Sim(3) loop), b's surroundings are `scale` times as large in a's unit as in b's own, and the relative
-// pose is in a's unit, both units the keyframes' odometry's (PlaceKeyframe::unit undone); metric loops are in metres
-// with a scale of 1.
+// pose is in a's unit, both units the keyframes' odometry's (PlaceKeyframe::unit undone); rigid loops are in the
+// world's unit (metres, or the unit a rig without overlap had when it closed them: LoopCloser::followRescale keeps
+// them in step with its rescales) with a scale of 1.
 struct LoopEdge {
   int64_t a = -1, b = -1;  // place keyframe ids
   SE3 T_a_b;
