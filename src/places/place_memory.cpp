@@ -186,6 +186,9 @@ void PlaceMemory::gatherPoints(const Map& local, const Rig& rig, const Keyframe&
                                std::span<Eigen::Vector3f> own) {
   const SE3 T_k_o = kf.T_w_b.inverse();
   const double unit = map_.keyframe(slot).unit;  // the place map's points are in the world's unit
+  // One camera's window has no metric lever arm to fit its unit against: its points fit its keyframes already, and
+  // one keypoint's ray would only add that keypoint's noise (BENCHMARKS.md section 10).
+  const bool on_rays = rig.size() > 1;
   const int levels_up = words_.directLevelsUp();
   ++gather_stamp_;
   for (int c = 0; c < kf.features.cameras(); ++c) {
@@ -203,7 +206,7 @@ void PlaceMemory::gatherPoints(const Map& local, const Rig& rig, const Keyframe&
       if (!l.metric && local.observingKeyframes(lm) < 3) continue;
       PlacePoint p;
       const Vec3 p_b = unit * (T_k_o * l.p_w);
-      const bool seen = kf.features.valid[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)];
+      const bool seen = on_rays && kf.features.valid[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)];
       const Vec3& bearing = kf.features.bearings[static_cast<std::size_t>(c)][static_cast<std::size_t>(k)];
       p.p_k = (seen ? ontoObservedRay(p_b, rig.T_b_c(c), bearing) : p_b).cast<float>();
       if (!own.empty()) own[static_cast<std::size_t>(c * features_per_camera_ + k)] = p.p_k;
