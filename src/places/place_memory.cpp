@@ -186,8 +186,8 @@ void PlaceMemory::gatherPoints(const Map& local, const Rig& rig, const Keyframe&
                                std::span<Eigen::Vector3f> own) {
   const SE3 T_k_o = kf.T_w_b.inverse();
   const double unit = map_.keyframe(slot).unit;  // the place map's points are in the world's unit
-  // One camera's window has no metric lever arm to fit its unit against: its points fit its keyframes already, and
-  // one keypoint's ray would only add that keypoint's noise (BENCHMARKS.md section 10).
+  // One camera's window has no metric lever arm for its unit to disagree with: its points fit its keyframes
+  // already, and one keypoint's ray would only add that keypoint's noise.
   const bool on_rays = rig.size() > 1;
   const int levels_up = words_.directLevelsUp();
   ++gather_stamp_;

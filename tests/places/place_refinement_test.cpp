@@ -38,26 +38,48 @@ int expectRefinedPoses(const PlaceMap& places, const Map& local) {
 
 // The place keyframe with this id, or nullptr.
 const PlaceKeyframe* placeOfId(const PlaceMap& map, int64_t id) {
-  for (int slot = 0; slot < map.capacity(); ++slot)
-    if (map.keyframe(slot).alive && map.keyframe(slot).id == id) return &map.keyframe(slot);
-  return nullptr;
+  const int slot = map.slotOfId(id);
+  return slot >= 0 ? &map.keyframe(slot) : nullptr;
 }
 
+// A rig of three cameras without overlap on the synthetic sequence, its odometry and its place memory (loop
+// detections waited for, so that runs repeat); the tests drive the frames themselves.
+struct PlacesOnSequence {
+  explicit PlacesOnSequence(const test::SyntheticSequenceOptions& so)
+      : rig(test::nonOverlappingRig3()),
+        seq(rig, so),
+        overlap(rig, OverlapOptions{}),
+        matcher(rig, overlap, MultiViewOptions{}, so.max_features),
+        odometry(rig, odometry_options, so.max_features),
+        memory(rig, vocabulary(), repeatable(), odometry_options, so.max_features),
+        frame(rig.size(), so.max_features) {}
+
+  static const Vocabulary& vocabulary() {
+    static const Vocabulary v = loadVocabulary("");
+    return v;
+  }
+  static PlacesOptions repeatable() {
+    PlacesOptions places;
+    places.repeatable = true;
+    return places;
+  }
+
+  Rig rig;
+  test::SyntheticSequence seq;
+  OverlapMap overlap;
+  MultiViewMatcher matcher;
+  OdometryOptions odometry_options;
+  Odometry odometry;
+  PlaceMemory memory;
+  FrameFeatures frame;
+};
+
 TEST(PlaceRefinement, PlacesOfAnUncertainUnitTakeTheWindowsPointsWhenTheirKeyframeLeavesIt) {
-  const Rig rig = test::nonOverlappingRig3();
   test::SyntheticSequenceOptions so;
   so.frames = 100;
   so.warmup_frames = 30;  // the refinements come within the first 60 frames
-  test::SyntheticSequence seq(rig, so);
-  OverlapMap overlap(rig, OverlapOptions{});
-  MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
-  const OdometryOptions odometry_options;
-  Odometry odometry(rig, odometry_options, so.max_features);
-  static const Vocabulary vocabulary = loadVocabulary("");
-  PlacesOptions places;
-  places.repeatable = true;
-  PlaceMemory memory(rig, vocabulary, places, odometry_options, so.max_features);
-  FrameFeatures frame(rig.size(), so.max_features);
+  PlacesOnSequence run(so);
+  auto& [rig, seq, overlap, matcher, odometry_options, odometry, memory, frame] = run;
   int first_points_when_made = -1;  // of the map's first place keyframe, in the frame it joined the place map
   uint64_t allocations = 0, refined_in_warm_up = 0;
   int compared = 0;
@@ -105,19 +127,10 @@ TEST(PlaceRefinement, PlacesOfAnUncertainUnitTakeTheWindowsPointsWhenTheirKeyfra
 // its camera's keypoints, whatever depth the window's solve gave it. (The keypoints carry 0.5 px of noise, so the
 // solved points lie off their rays by about that much: a loop from where the keyframe was would measure that.)
 TEST(PlaceRefinement, APlacesPointsLieOnItsKeyframesRays) {
-  const Rig rig = test::nonOverlappingRig3();
   test::SyntheticSequenceOptions so;
   so.frames = 60;
-  test::SyntheticSequence seq(rig, so);
-  OverlapMap overlap(rig, OverlapOptions{});
-  MultiViewMatcher matcher(rig, overlap, MultiViewOptions{}, so.max_features);
-  const OdometryOptions odometry_options;
-  Odometry odometry(rig, odometry_options, so.max_features);
-  static const Vocabulary vocabulary = loadVocabulary("");
-  PlacesOptions places;
-  places.repeatable = true;
-  PlaceMemory memory(rig, vocabulary, places, odometry_options, so.max_features);
-  FrameFeatures frame(rig.size(), so.max_features);
+  PlacesOnSequence run(so);
+  auto& [rig, seq, overlap, matcher, odometry_options, odometry, memory, frame] = run;
   for (int i = 0; i < seq.frames(); ++i) {
     seq.fill(i, frame);
     matcher.compute(frame);
